@@ -1,0 +1,33 @@
+#pragma once
+
+#include <vector>
+
+#include "mobility_analysis/Mechanism.hpp"
+
+namespace mobility_analysis {
+
+/// Link poses in the root (ground) frame, indexed like Mechanism::links.
+using LinkPoses = std::vector<Eigen::Isometry3d>;
+
+/**
+ * @brief Forward kinematics of the joint tree: T_child = T_parent * origin * motion(q).
+ * @param[in] mechanism the mechanism.
+ * @param[in] positions tree-joint values [rad] or [m]; joints not listed are at 0.
+ * @return Pose of every link in the root frame.
+ */
+LinkPoses computeTreePoses(const Mechanism& mechanism, const JointPositions& positions);
+
+/**
+ * @brief How far @p joint is from holding at @p poses: the distance between its two joint-frame origins
+ *        that the joint type forbids [m] plus the angle between axes it forbids [rad] times @p lengthScale.
+ */
+double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int joint, double lengthScale);
+
+/**
+ * @brief A characteristic length of the mechanism [m]: the RMS distance of all joint-frame origins (at
+ *        @p poses) from their centroid; 1 when they all coincide. Every length is divided by it before an
+ *        equation is built, so that tolerances do not depend on the unit.
+ */
+double computeCharacteristicLength(const Mechanism& mechanism, const LinkPoses& poses);
+
+}  // namespace mobility_analysis

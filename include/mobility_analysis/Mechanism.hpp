@@ -1,0 +1,76 @@
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace mobility_analysis {
+
+/// Joint types of the closed-loop URDF dialect (DESIGN.md §2). `Planar` and `Floating` are URDF tree types.
+enum class JointType { Revolute, Continuous, Prismatic, Cylindrical, Spherical, Universal, Planar, Fixed, Floating };
+
+/// Where a connection between two links comes from; also the order of its equations (DESIGN.md §3).
+enum class ConnectionKind { TreeJoint, DistanceConstraint, Cable, LoopJoint };
+
+/// Passive cables constrain while taut; active cables are the driver and constrain nothing.
+enum class CableType { Passive, Active };
+
+/// A rigid link; its frame is the URDF link frame.
+struct Link {
+  std::string name;
+};
+
+/**
+ * @brief One connection between two links: a URDF joint, a `loop_joint`, a `distance_constraint` or a `cable`.
+ *
+ * The joint frame is given on each side: `frame1` in link1's frame and `frame2` in link2's frame. For a tree
+ * joint link1 is the parent, `frame1` the URDF origin and `frame2` the identity (the child frame is the joint
+ * frame). The joint holds when the two frames coincide up to the joint's own motion about/along `axis`.
+ */
+struct Joint {
+  std::string name;
+  ConnectionKind kind = ConnectionKind::TreeJoint;
+  JointType type = JointType::Fixed;  ///< Distance constraints and cables use Spherical (ball ends).
+  int link1 = -1;                     ///< Index into Mechanism::links (tree: parent).
+  int link2 = -1;                     ///< Index into Mechanism::links (tree: child).
+  Eigen::Isometry3d frame1 = Eigen::Isometry3d::Identity();  ///< Joint frame in link1's frame [m].
+  Eigen::Isometry3d frame2 = Eigen::Isometry3d::Identity();  ///< Joint frame in link2's frame [m].
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();   ///< Unit axis in the joint frame.
+  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< Universal only: second unit axis, on link2.
+  double length = 0.0;                               ///< Cable: declared length [m]; else unused.
+  CableType cableType = CableType::Passive;          ///< Cable only.
+};
+
+/// Joint values by tree-joint name [rad] or [m].
+using JointPositions = std::map<std::string, double>;
+
+/**
+ * @brief An immutable closed-loop mechanism as read from the URDF.
+ *
+ * `joints` holds every connection in the order of its constraint equations: tree joints in document order,
+ * then distance constraints, then cables, then loop joints (DESIGN.md §3).
+ */
+struct Mechanism {
+  std::string name;             ///< URDF robot name.
+  std::string file;             ///< Source file name, for diagnostics.
+  std::vector<Link> links;      ///< Links in document order.
+  std::vector<Joint> joints;    ///< Connections in equation order.
+  int rootLink = 0;             ///< The ground.
+
+  /// @return Index of the link called @p linkName, if any.
+  std::optional<int> findLink(const std::string& linkName) const;
+  /// @return Index of the connection called @p jointName, if any.
+  std::optional<int> findJoint(const std::string& jointName) const;
+  /// @return Index of the tree joint whose child is @p link, if any (none for the root).
+  std::optional<int> findParentJoint(int link) const;
+};
+
+/// @return The dialect's spelling of @p type ("revolute", …).
+const char* toString(JointType type);
+/// @return "joint", "distance_constraint", "cable" or "loop_joint".
+const char* toString(ConnectionKind kind);
+
+}  // namespace mobility_analysis

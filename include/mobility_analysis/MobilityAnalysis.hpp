@@ -1,0 +1,48 @@
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "mobility_analysis/Assembly.hpp"
+#include "mobility_analysis/Diagnostic.hpp"
+#include "mobility_analysis/Mechanism.hpp"
+#include "mobility_analysis/MobilityReport.hpp"
+#include "mobility_analysis/NaturalCoordinates.hpp"
+#include "mobility_analysis/RedundancyAnalysis.hpp"
+
+namespace mobility_analysis {
+
+/// Options of one analysis.
+struct AnalysisOptions {
+  AnalysisMode mode = AnalysisMode::Auto;
+  JointPositions positions;       ///< Starting pose; empty: the URDF pose (all tree joints at 0).
+  double rankTolerance = -1.0;    ///< Relative rank threshold; <= 0: tolerances::kRank.
+  /// Links with more than this many equations in all skip the redundant-link search (each candidate costs one
+  /// elimination); the report then says redundant_links_computed: false.
+  int redundantLinkSearchLimit = 200000;
+  /// Called with a phase name and a fraction in [0, 1] during long analyses; may be empty.
+  std::function<void(const std::string&, double)> progress;
+};
+
+/// The whole answer for one mechanism: the report plus what the ROS layer draws.
+struct MobilityAnalysis {
+  MobilityReport report;
+  AssembledMechanism assembled;
+};
+
+/**
+ * @brief Assembles @p mechanism, builds its natural coordinates, and answers DOF, Grübler and redundancy.
+ *
+ * The one path shared by the CLI and the services.
+ * @return The analysis, or the Diagnostic of the first thing that went wrong.
+ */
+Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const AnalysisOptions& options);
+
+/**
+ * @brief Grübler–Kutzbach count, eq. (1) of the lecture: lambda (N - J - 1) + sum F_i, with each connection's
+ *        freedom in the model's mode (a distance constraint or taut cable counts as one equation; ignored
+ *        cables count as nothing).
+ */
+int computeGrublerKutzbach(const Mechanism& mechanism, const CoordinateModel& model);
+
+}  // namespace mobility_analysis

@@ -1,0 +1,50 @@
+#pragma once
+
+namespace mobility_analysis {
+
+/**
+ * @brief Every numerical threshold of the core, in one place.
+ *
+ * Lengths are divided by the mechanism's characteristic length (the RMS distance of its joint
+ * points from their centroid) before any equation is built, so every tolerance below is
+ * dimensionless and the same mechanism in millimetres and in metres gives the same answer.
+ */
+namespace tolerances {
+
+/// Relative threshold of the ordered rank test [-]: an equation whose Jacobian row, reduced by the
+/// rows before it, keeps less than this fraction of its own norm is redundant. Overridden by
+/// `~rank_tolerance` / `--rank-tolerance`.
+constexpr double kRank = 1e-8;
+
+/// A rank decision whose margin (kept pivot / threshold or threshold / dropped residual) is
+/// below this factor is reported as near the tolerance [-].
+constexpr double kNearDecisionFactor = 100.0;
+
+/// Loop closure residual accepted as closed [normalised length].
+constexpr double kClosure = 1e-9;
+
+/// Maximum Newton iterations of the assembly.
+constexpr int kAssemblyMaxIterations = 50;
+
+/// A loop residual above this after assembly means the loop cannot be closed [normalised length].
+constexpr double kAssemblyFailure = 1e-6;
+
+/// Two directions of a body are independent when the sine of their angle exceeds this [-].
+constexpr double kIndependentDirection = 1e-3;
+
+/// A vector given in the URDF is zero when its norm is below this [-] (axis) or [m] (offsets).
+constexpr double kZeroVector = 1e-12;
+
+/// Axes are parallel (or a prismatic axis perpendicular) for the planar test when the sine
+/// (cosine) of their angle is below this [-].
+constexpr double kPlanarAxis = 1e-6;
+
+/// A passive cable is taut when |distance - length| is below this fraction of its length [-].
+constexpr double kCableTaut = 1e-6;
+
+/// Pivot acceptance in the sparse ordered elimination: any entry at least this fraction of the
+/// largest entry of the reduced row may be the pivot (threshold partial pivoting) [-].
+constexpr double kPivotThreshold = 0.1;
+
+}  // namespace tolerances
+}  // namespace mobility_analysis

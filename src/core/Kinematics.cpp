@@ -1,0 +1,106 @@
+#include "mobility_analysis/Kinematics.hpp"
+
+#include <cmath>
+
+#include "mobility_analysis/Tolerances.hpp"
+
+namespace mobility_analysis {
+
+namespace {
+
+/// URDF joint motion: a turn about, or a slide along, the joint axis.
+Eigen::Isometry3d jointMotion(const Joint& joint, double value) {
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  if (joint.type == JointType::Revolute || joint.type == JointType::Continuous) {
+    motion.linear() = Eigen::AngleAxisd(value, joint.axis).toRotationMatrix();
+  } else if (joint.type == JointType::Prismatic) {
+    motion.translation() = value * joint.axis;
+  }
+  return motion;
+}
+
+}  // namespace
+
+LinkPoses computeTreePoses(const Mechanism& mechanism, const JointPositions& positions) {
+  const size_t numLinks = mechanism.links.size();
+  LinkPoses poses(numLinks, Eigen::Isometry3d::Identity());
+  std::vector<int> parentJoint(numLinks, -1);
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    if (mechanism.joints[j].kind == ConnectionKind::TreeJoint) {
+      parentJoint[mechanism.joints[j].link2] = static_cast<int>(j);
+    }
+  }
+  std::vector<bool> done(numLinks, false);
+  done[mechanism.rootLink] = true;
+  // The loader guarantees a tree; resolve each link after its parent.
+  std::vector<int> chain;
+  for (size_t link = 0; link < numLinks; ++link) {
+    chain.clear();
+    for (int l = static_cast<int>(link); !done[l]; l = mechanism.joints[parentJoint[l]].link1) {
+      chain.push_back(l);
+    }
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const Joint& joint = mechanism.joints[parentJoint[*it]];
+      const auto value = positions.find(joint.name);
+      poses[*it] = poses[joint.link1] * joint.frame1 * jointMotion(joint, value == positions.end() ? 0.0 : value->second);
+      done[*it] = true;
+    }
+  }
+  return poses;
+}
+
+double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int jointIndex, double lengthScale) {
+  const Joint& joint = mechanism.joints[jointIndex];
+  if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
+      joint.type == JointType::Floating) {
+    return 0.0;  // a distance constraint takes its length from the pose; cables are checked for tautness
+  }
+  const Eigen::Isometry3d f1 = poses[joint.link1] * joint.frame1;
+  const Eigen::Isometry3d f2 = poses[joint.link2] * joint.frame2;
+  const Eigen::Vector3d offset = f2.translation() - f1.translation();
+  const Eigen::Vector3d a1 = f1.linear() * joint.axis;
+  const Eigen::Vector3d a2 = f2.linear() * joint.axis;
+  const double axisError = a1.cross(a2).norm() + std::max(0.0, -a1.dot(a2));
+  const double frameError = (f1.linear() - f2.linear()).norm();
+  switch (joint.type) {
+    case JointType::Revolute:
+    case JointType::Continuous: return offset.norm() + lengthScale * axisError;
+    case JointType::Prismatic: return offset.cross(a1).norm() + lengthScale * frameError;
+    case JointType::Cylindrical: return offset.cross(a1).norm() + lengthScale * axisError;
+    case JointType::Spherical: return offset.norm();
+    case JointType::Universal:
+      return offset.norm() +
+             lengthScale * std::abs(a1.dot(f2.linear() * joint.axis2) - joint.axis.dot(joint.axis2));
+    case JointType::Planar: return std::abs(offset.dot(a1)) + lengthScale * axisError;
+    case JointType::Fixed: return offset.norm() + lengthScale * frameError;
+    case JointType::Floating: return 0.0;
+  }
+  return 0.0;
+}
+
+double computeCharacteristicLength(const Mechanism& mechanism, const LinkPoses& poses) {
+  std::vector<Eigen::Vector3d> points;
+  for (const Joint& joint : mechanism.joints) {
+    if (joint.type == JointType::Floating) {
+      continue;
+    }
+    points.push_back(poses[joint.link1] * joint.frame1.translation());
+    points.push_back(poses[joint.link2] * joint.frame2.translation());
+  }
+  if (points.size() < 2) {
+    return 1.0;
+  }
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) {
+    centroid += p;
+  }
+  centroid /= static_cast<double>(points.size());
+  double sum = 0.0;
+  for (const Eigen::Vector3d& p : points) {
+    sum += (p - centroid).squaredNorm();
+  }
+  const double rms = std::sqrt(sum / static_cast<double>(points.size()));
+  return rms > tolerances::kZeroVector ? rms : 1.0;
+}
+
+}  // namespace mobility_analysis

@@ -1,0 +1,168 @@
+#include "mobility_analysis/MobilityReport.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+namespace mobility_analysis {
+
+const char* toString(ElementClass elementClass) {
+  switch (elementClass) {
+    case ElementClass::Neutral: return "neutral";
+    case ElementClass::OverConstrainedLoop: return "over_constrained_loop";
+    case ElementClass::Redundant: return "redundant";
+  }
+  return "unknown";
+}
+
+namespace {
+
+std::string quote(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char escaped[8];
+          std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+          out += escaped;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+/// Numbers with a fixed number of significant digits, so equal reports print equal text.
+std::string number(double value, int digits = 9) {
+  char text[40];
+  std::snprintf(text, sizeof(text), "%.*g", digits, value);
+  return text;
+}
+
+template <class T, class F>
+std::string array(const std::vector<T>& items, F&& write) {
+  std::string out = "[";
+  for (size_t i = 0; i < items.size(); ++i) {
+    out += (i ? ", " : "") + write(items[i]);
+  }
+  return out + "]";
+}
+
+std::string statusJson(const ElementStatus& s) {
+  return "{\"name\": " + quote(s.name) + ", \"kind\": " + quote(s.kind) + ", \"type\": " + quote(s.type) +
+         ", \"class\": " + quote(toString(s.elementClass)) + "}";
+}
+
+}  // namespace
+
+std::string toJson(const MobilityReport& r) {
+  std::ostringstream out;
+  out << "{\n";
+  out << "  \"robot\": " << quote(r.robot) << ",\n";
+  out << "  \"file\": " << quote(r.file) << ",\n";
+  out << "  \"mode\": " << quote(r.mode) << ",\n";
+  out << "  \"lambda\": " << r.lambda << ",\n";
+  out << "  \"dof\": " << r.dof << ",\n";
+  out << "  \"grubler_kutzbach_dof\": " << r.grublerKutzbachDof << ",\n";
+  out << "  \"num_coordinates\": " << r.numCoordinates << ",\n";
+  out << "  \"num_constraints\": " << r.numConstraints << ",\n";
+  out << "  \"rank\": " << r.rank << ",\n";
+  out << "  \"num_redundant\": " << r.numRedundant << ",\n";
+  out << "  \"nullity_trace\": " << array(r.nullityTrace, [](int v) { return std::to_string(v); }) << ",\n";
+  out << "  \"redundant_constraints\": "
+      << array(r.redundantConstraints,
+               [](const RedundantConstraint& c) {
+                 return "{\"index\": " + std::to_string(c.index) + ", \"source\": " + quote(c.source) +
+                        ", \"name\": " + quote(c.name) + ", \"kind\": " + quote(c.kind) +
+                        ", \"equation\": " + quote(c.equation) + "}";
+               })
+      << ",\n";
+  out << "  \"redundant_joints\": "
+      << array(r.redundantJoints,
+               [](const RedundantJoint& j) {
+                 return "{\"name\": " + quote(j.name) + ", \"redundant_equations\": " +
+                        std::to_string(j.redundantEquations) + ", \"equations\": " + std::to_string(j.equations) + "}";
+               })
+      << ",\n";
+  out << "  \"redundant_links\": " << array(r.redundantLinks, quote) << ",\n";
+  out << "  \"redundant_links_computed\": " << (r.redundantLinksComputed ? "true" : "false") << ",\n";
+  out << "  \"redundant_boundaries\": " << array(r.redundantBoundaries, quote) << ",\n";
+  out << "  \"links\": " << array(r.links, statusJson) << ",\n";
+  out << "  \"joints\": " << array(r.joints, statusJson) << ",\n";
+  out << "  \"cables\": "
+      << array(r.cables,
+               [](const CableState& c) {
+                 return "{\"name\": " + quote(c.name) + ", \"type\": " + quote(c.type) + ", \"state\": " +
+                        quote(c.state) + ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) +
+                        "}";
+               })
+      << ",\n";
+  out << "  \"rank_margin\": {\"tolerance\": " << number(r.rankMargin.tolerance, 3)
+      << ", \"smallest_kept_pivot\": " << number(r.rankMargin.smallestKeptPivot, 3)
+      << ", \"largest_dropped_residual\": " << number(r.rankMargin.largestDroppedResidual, 3)
+      << ", \"near_tolerance\": " << (r.rankMargin.nearTolerance ? "true" : "false") << "},\n";
+  out << "  \"characteristic_length\": " << number(r.characteristicLength) << ",\n";
+  out << "  \"closure_residual\": {\"before\": " << number(r.closureResidualBefore, 3)
+      << ", \"after\": " << number(r.closureResidualAfter, 3) << "}\n";
+  out << "}\n";
+  return out.str();
+}
+
+std::string toText(const MobilityReport& r) {
+  std::ostringstream out;
+  out << "Mechanism '" << r.robot << "' (" << r.file << "), " << r.mode << " analysis (lambda = " << r.lambda << ")\n";
+  out << "  degrees of freedom (nullity of the constraint Jacobian): " << r.dof << "\n";
+  out << "  Grubler-Kutzbach count:                                  " << r.grublerKutzbachDof << "\n";
+  out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints << ", rank "
+      << r.rank << "\n";
+  out << "  redundant equations: " << r.numRedundant << " (= dof - Grubler = " << r.dof - r.grublerKutzbachDof
+      << ")\n";
+  for (const RedundantJoint& j : r.redundantJoints) {
+    out << "    joint " << j.name << ": " << j.redundantEquations << " of " << j.equations << " equations redundant\n";
+  }
+  for (const RedundantConstraint& c : r.redundantConstraints) {
+    out << "      #" << c.index << " [" << c.source << " " << c.name << ", " << c.kind << "] " << c.equation << "\n";
+  }
+  out << "  redundant links: ";
+  if (!r.redundantLinksComputed) {
+    out << "(not computed: the model is too large for the per-link search)";
+  } else if (r.redundantLinks.empty()) {
+    out << "none";
+  }
+  for (size_t i = 0; i < r.redundantLinks.size(); ++i) out << (i ? ", " : "") << r.redundantLinks[i];
+  out << "\n  redundant boundary (ground) constraints: ";
+  if (r.redundantBoundaries.empty()) out << "none";
+  for (size_t i = 0; i < r.redundantBoundaries.size(); ++i) out << (i ? ", " : "") << r.redundantBoundaries[i];
+  out << "\n";
+  std::vector<std::string> loop;
+  for (const ElementStatus& s : r.links) {
+    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
+  }
+  for (const ElementStatus& s : r.joints) {
+    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
+  }
+  if (!loop.empty()) {
+    out << "  other members of over-constrained loops: ";
+    for (size_t i = 0; i < loop.size(); ++i) out << (i ? ", " : "") << loop[i];
+    out << "\n";
+  }
+  for (const CableState& c : r.cables) {
+    out << "  cable " << c.name << " (" << c.type << "): " << c.state << ", length " << number(c.length, 6)
+        << " m, ends " << number(c.distance, 6) << " m apart\n";
+  }
+  out << "  rank margin: smallest kept pivot " << number(r.rankMargin.smallestKeptPivot, 3)
+      << ", largest dropped residual " << number(r.rankMargin.largestDroppedResidual, 3) << " (tolerance "
+      << number(r.rankMargin.tolerance, 3) << ")" << (r.rankMargin.nearTolerance ? "  WARNING: near the tolerance" : "")
+      << "\n";
+  out << "  lengths in Lc = " << number(r.characteristicLength, 6) << " m; loop closure residual "
+      << number(r.closureResidualBefore, 3) << " m before assembly, " << number(r.closureResidualAfter, 3)
+      << " m after\n";
+  return out.str();
+}
+
+}  // namespace mobility_analysis

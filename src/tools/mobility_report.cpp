@@ -1,0 +1,96 @@
+/// mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] [--rank-tolerance T] [--json]
+/// Prints the mobility report of a closed-loop URDF; on bad input one line on stderr and exit code 2.
+
+#include <chrono>
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+#include <string>
+
+#include "mobility_analysis/mobility_analysis.hpp"
+
+namespace {
+
+constexpr int kBadInput = 2;
+
+int fail(const std::string& line) {
+  std::cerr << line << std::endl;
+  return kBadInput;
+}
+
+const char* kUsage =
+    "usage: mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] "
+    "[--rank-tolerance T] [--json]";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace mobility_analysis;
+  try {
+    std::string file, modeText = "auto", positionsText;
+    double rankTolerance = -1.0;
+    bool json = false;
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      auto next = [&](const std::string& option) -> const char* {
+        if (i + 1 >= argc) return nullptr;
+        (void)option;
+        return argv[++i];
+      };
+      if (arg == "--json") {
+        json = true;
+      } else if (arg == "--mode" || arg == "--positions" || arg == "--rank-tolerance") {
+        const char* value = next(arg);
+        if (value == nullptr) return fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage);
+        if (arg == "--mode") modeText = value;
+        if (arg == "--positions") positionsText = value;
+        if (arg == "--rank-tolerance") {
+          char* end = nullptr;
+          rankTolerance = std::strtod(value, &end);
+          if (*end != '\0' || !(rankTolerance > 0.0 && rankTolerance < 1.0)) {
+            return fail(std::string("mobility_report: --rank-tolerance '") + value + "' is not a number in (0, 1)");
+          }
+        }
+      } else if (arg == "-h" || arg == "--help") {
+        std::cout << kUsage << std::endl;
+        return 0;
+      } else if (!arg.empty() && arg[0] == '-') {
+        return fail("mobility_report: unknown option '" + arg + "'; " + kUsage);
+      } else if (file.empty()) {
+        file = arg;
+      } else {
+        return fail("mobility_report: more than one file given ('" + file + "', '" + arg + "'); " + kUsage);
+      }
+    }
+    if (file.empty()) return fail(std::string("mobility_report: no URDF file given; ") + kUsage);
+
+    const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
+    if (!isOk(mode)) return fail("mobility_report: --mode '" + modeText + "' is not one of auto, planar, spatial");
+    const Result<Mechanism> mechanism = loadMechanismFromFile(file);
+    if (!isOk(mechanism)) return fail(diagnosticOf(mechanism).toString());
+    AnalysisOptions options;
+    options.mode = valueOf(mode);
+    options.rankTolerance = rankTolerance;
+    if (!positionsText.empty()) {
+      const Result<JointPositions> positions = parseJointPositions(positionsText, valueOf(mechanism));
+      if (!isOk(positions)) return fail(diagnosticOf(positions).toString());
+      options.positions = valueOf(positions);
+    }
+    // Long analyses say where they are on stderr; stdout stays the report alone.
+    options.progress = [start = std::chrono::steady_clock::now(), last = -1.0](const std::string& phase,
+                                                                               double fraction) mutable {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (elapsed > 1.0 && fraction - last >= 0.1) {
+        std::cerr << "mobility_report: " << phase << " " << static_cast<int>(100 * fraction) << "% (" << elapsed
+                  << " s)" << std::endl;
+        last = fraction;
+      }
+    };
+    const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+    if (!isOk(analysis)) return fail(diagnosticOf(analysis).toString());
+    std::cout << (json ? toJson(valueOf(analysis).report) : toText(valueOf(analysis).report));
+    return 0;
+  } catch (const std::exception& e) {
+    return fail(std::string("mobility_report: internal error: ") + e.what());
+  }
+}
