@@ -14,16 +14,21 @@ namespace {
 
 double maxAbs(const Eigen::VectorXd& v) { return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff(); }
 
-/// The connection whose equations are furthest from holding, with that residual.
-std::pair<int, double> worstJoint(const CoordinateModel& model, const Eigen::VectorXd& phi) {
+/// The loop-closing connection (loop joint, distance constraint, cable) furthest from holding, with that
+/// residual; a tree joint only when no loop element is violated.
+std::pair<int, double> worstJoint(const Mechanism& mechanism, const CoordinateModel& model,
+                                  const Eigen::VectorXd& phi) {
   int worst = -1;
   double residual = 0.0;
-  for (int i = 0; i < model.numConstraints(); ++i) {
-    const ConstraintEquation& eq = model.equations[i];
-    if (eq.source == EquationSource::Joint && std::abs(phi(i)) > residual) {
+  for (const bool loopsOnly : {true, false}) {
+    for (int i = 0; i < model.numConstraints(); ++i) {
+      const ConstraintEquation& eq = model.equations[i];
+      if (eq.source != EquationSource::Joint || std::abs(phi(i)) <= residual) continue;
+      if (loopsOnly && mechanism.joints[eq.element].kind == ConnectionKind::TreeJoint) continue;
       residual = std::abs(phi(i));
       worst = eq.element;
     }
+    if (worst >= 0) break;
   }
   return {worst, residual};
 }
@@ -78,7 +83,7 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   }
   assembled.iterations = iteration;
   if (maxAbs(phi) > tolerances::kAssemblyFailure) {
-    const auto [joint, residual] = worstJoint(model3, phi);
+    const auto [joint, residual] = worstJoint(mechanism, model3, phi);
     char what[200];
     std::snprintf(what, sizeof(what),
                   "the loop cannot be closed: residual %.3g m after %d Newton iterations (from %.3g m)", residual * lc,
@@ -95,7 +100,7 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   computeConstraintResidual(assembled.model, assembled.q, phi);
   assembled.finalResidual = maxAbs(phi) * lc;
   if (maxAbs(phi) > tolerances::kAssemblyFailure) {
-    const auto [joint, residual] = worstJoint(assembled.model, phi);
+    const auto [joint, residual] = worstJoint(mechanism, assembled.model, phi);
     char what[160];
     std::snprintf(what, sizeof(what), "the assembled pose does not satisfy the constraints (residual %.3g m)",
                   residual * lc);
