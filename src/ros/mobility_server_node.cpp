@@ -1,0 +1,17 @@
+/// mobility_server: serves the DOF and redundancy of the mechanism in `robot_description` (see MobilityServer).
+
+#include <cstdlib>
+
+#include <ros/ros.h>
+
+#include "mobility_analysis/ros/MobilityServer.hpp"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "mobility_server");
+  ros::NodeHandle nodeHandle;
+  ros::NodeHandle privateNodeHandle("~");
+  mobility_analysis::MobilityServer server(nodeHandle, privateNodeHandle);
+  if (!server.isConfigured()) return EXIT_FAILURE;  // ROS_FATAL already said which parameter.
+  ros::spin();
+  return EXIT_SUCCESS;
+}
