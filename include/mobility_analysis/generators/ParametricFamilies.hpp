@@ -1,0 +1,110 @@
+#pragma once
+
+#include "mobility_analysis/generators/MechanismDescription.hpp"
+
+#include <vector>
+
+namespace mobility_analysis {
+
+/**
+ * @brief Closed-form expectations of the planar scissor (SLE) mast with @p units units.
+ *
+ * Links 2N + 2 (ground, slider, 2N bars), joints 3N + 1 (ground pin, slide, slider pin, N centre pivots,
+ * 2(N − 1) end pins). planar (λ 3): DOF 1, Grübler 3(2N+2 − 3N−1 − 1) + 3N+1 = 1, redundant 0;
+ * spatial (λ 6): DOF 1, Grübler 1 − 3N, redundant 3N.
+ */
+std::vector<FamilyExpectation> expectSlePlanarMast(int units);
+
+/**
+ * @brief Planar scissor (SLE) mast in the x–y plane: N units of two crossing bars (length 1 m, 50° to the
+ *        horizontal, pivoted at their midpoints), bar 1a pinned to the ground, bar 1b's foot pinned to a slider
+ *        block that slides along x on the ground.
+ * @param[in] units N ≥ 1.
+ * @note Expectations: see expectSlePlanarMast().
+ */
+MechanismDescription makeSlePlanarMast(int units);
+
+/**
+ * @brief Closed-form expectations of the triangular scissor mast (makeSleSpatialMast()).
+ *
+ * Links 6N (6 bars per unit, one of them the ground), joints 12N − 3: 3N centre revolutes, 6(N − 1) face
+ * pins (revolute) and 3(N + 1) corner spherical joints; Σ F = 18N + 3.
+ * spatial (λ 6): DOF 1, Grübler 6(6N − (12N − 3) − 1) + 18N + 3 = 15 − 18N, redundant 18N − 14.
+ */
+std::vector<FamilyExpectation> expectSleSpatialMast(int units);
+
+/**
+ * @brief Spatial scissor mast: a right prism on an equilateral triangle whose three faces are planar scissor
+ *        chains (bars 1 m at 50° to the horizontal, centre pivots normal to the face); at every node level the
+ *        two faces meeting at a corner are joined by a spherical joint, and bar `bar_1_0_a` is the ground.
+ *
+ * Why DOF 1: each face is a planar chain of identical units, so its nodes lie on two parallel edges, equally
+ * spaced; shared corner nodes force equal unit heights, hence equal widths w on all faces; three faces
+ * sharing their edges pairwise make a right prism on an equilateral triangle of side w, and w (with
+ * h² + w² = 1) is the only parameter. Per unit 6 links and 12 joints (≈ 54 joint equations).
+ * @param[in] units N ≥ 1.
+ * @note Expectations: see expectSleSpatialMast().
+ */
+MechanismDescription makeSleSpatialMast(int units);
+
+/**
+ * @brief Closed-form expectations of the Hoberman-type ring with @p units angulated units (N ≥ 3).
+ *
+ * Links 2N, joints 3N revolute (N kinks + 2N end pins).
+ * planar (λ 3): DOF 1, Grübler 3(2N − 3N − 1) + 3N = −3, redundant 4;
+ * spatial (λ 6): DOF 1, Grübler −3N − 6, redundant 3N + 7.
+ */
+std::vector<FamilyExpectation> expectHobermanRing(int units);
+
+/**
+ * @brief Hoberman-type ring: N units of two identical angulated bars (arms 0.5 m, both bent by κ = 2π/N the
+ *        same way) pinned at their kinks; unit j's bar a end 2 is pinned to unit j+1's bar b end 1 and vice
+ *        versa; bar `bar_0_a` is the ground.
+ *
+ * Why it moves: with arms u1, v1 at the kink and u2 = −Rot(κ) u1, v2 = −Rot(κ) v1, A2 − B2 = Rot(κ)(B1 − A1)
+ * for every opening angle, so the rotation by κ about a point O maps unit j onto unit j+1 and the ring closes
+ * for every opening: one freedom.
+ * @param[in] units N ≥ 3.
+ * @note Expectations: see expectHobermanRing().
+ */
+MechanismDescription makeHobermanRing(int units);
+
+/**
+ * @brief Closed-form expectations of a door on @p hinges coaxial hinges.
+ *
+ * Links 2, joints K revolute. spatial (λ 6): DOF 1, Grübler 6(2 − K − 1) + K = 6 − 5K, redundant 5K − 5;
+ * planar (λ 3): DOF 1, Grübler 3 − 2K, redundant 2K − 2.
+ */
+std::vector<FamilyExpectation> expectDoor(int hinges);
+
+/**
+ * @brief A door (link `door`) on K coaxial hinges along the world z axis, opened 40°: hinge_1 is the tree
+ *        revolute, the others are loop revolutes.
+ * @param[in] hinges K ≥ 1.
+ * @note Expectations: see expectDoor().
+ */
+MechanismDescription makeDoor(int hinges);
+
+/**
+ * @brief Closed-form expectations of an R × C parallelogram grid of continuous bars.
+ *
+ * Links R + C + 2 (R + 1 row bars incl. the ground row, C + 1 column bars), joints (R + 1)(C + 1) pins.
+ * planar (λ 3): DOF 1, Grübler R + C + 1 − 2RC, redundant 2RC − R − C;
+ * spatial (λ 6): DOF 1, Grübler R + C + 1 − 5RC, redundant 5RC − R − C.
+ */
+std::vector<FamilyExpectation> expectParallelogramGrid(int rows, int columns);
+
+/**
+ * @brief Planar grid of R × C congruent parallelogram cells made of continuous bars: R + 1 row bars (row 0 is
+ *        the ground) and C + 1 column bars, pinned where they cross.
+ *
+ * Why DOF 1: every row bar is rigid and every cell a parallelogram, so all row bars stay parallel to the
+ * ground and all column bars parallel to each other; the common column angle (the shear) is the only freedom.
+ * (With a separate bar per cell edge the count would be R + C − 1 instead.)
+ * @param[in] rows R ≥ 1.
+ * @param[in] columns C ≥ 1.
+ * @note Expectations: see expectParallelogramGrid().
+ */
+MechanismDescription makeParallelogramGrid(int rows, int columns);
+
+}  // namespace mobility_analysis

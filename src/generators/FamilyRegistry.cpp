@@ -1,0 +1,189 @@
+#include "mobility_analysis/generators/FamilyRegistry.hpp"
+
+#include "mobility_analysis/generators/ParametricFamilies.hpp"
+#include "mobility_analysis/generators/ReferenceMechanisms.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+
+namespace mobility_analysis {
+
+namespace {
+
+/// Largest count accepted: keeps a typo from exhausting memory (10^6 units ≈ 10^7 joints).
+constexpr int kMaxCount = 1000000;
+
+const FamilyInfo* findFamily(const std::string& name) {
+  for (const FamilyInfo& info : listFamilies()) {
+    if (info.name == name) {
+      return &info;
+    }
+  }
+  return nullptr;
+}
+
+std::optional<int> parseInt(const std::string& text) {
+  int value = 0;
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (result.ec != std::errc() || result.ptr != text.data() + text.size()) {
+    return std::nullopt;
+  }
+  return value;
+}
+
+std::optional<double> parseDouble(const std::string& text) {
+  if (text.empty()) {
+    return std::nullopt;
+  }
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size() || !std::isfinite(value)) {
+    return std::nullopt;
+  }
+  return value;
+}
+
+}  // namespace
+
+const std::vector<FamilyInfo>& listFamilies() {
+  static const std::vector<FamilyInfo> families = {
+      {"four_bar", 0, 0, "four_bar", "Grashof crank-rocker; planar DOF 1 G 1 R 0, spatial DOF 1 G -2 R 3"},
+      {"puma560", 0, 0, "puma560", "PUMA 560 open chain; spatial DOF 6 G 6 R 0"},
+      {"parallelogram_crank", 0, 0, "parallelogram_crank", "parallelogram + third crank pq; planar DOF 1 G 0 R 1"},
+      {"three_sliders", 0, 0, "three_sliders", "three sliders on an equilateral triangle; planar DOF 1 G 0 R 1"},
+      {"rppr", 0, 0, "rppr", "RPPR, slides collinear with the pivots; planar DOF 1 G 1 R 0"},
+      {"bennett", 0, 0, "bennett [--scale S]", "Bennett 4R; spatial DOF 1 G -2 R 3"},
+      {"sarrus", 0, 0, "sarrus", "Sarrus 6R; spatial DOF 1 G 0 R 1"},
+      {"bricard", 0, 0, "bricard", "line-symmetric Bricard 6R; spatial DOF 1 G 0 R 1"},
+      {"goldberg", 0, 0, "goldberg", "Goldberg 5R; spatial DOF 1 G -1 R 2"},
+      {"rssr", 0, 0, "rssr", "RSSR, rod floating; spatial DOF 2 G 2 R 0"},
+      {"sle_mast", 0, 0, "sle_mast", "= sle_planar 4"},
+      {"hoberman_ring", 0, 0, "hoberman_ring", "= hoberman 6"},
+      {"door", 0, 1, "door [K=3]", "door on K coaxial hinges; spatial DOF 1 G 6-5K R 5K-5, planar G 3-2K R 2K-2"},
+      {"sle_planar", 1, 1, "sle_planar N", "planar scissor mast, pin + slider base; planar DOF 1 G 1 R 0"},
+      {"sle_spatial", 1, 1, "sle_spatial N", "triangular scissor mast; spatial DOF 1 G 15-18N R 18N-14"},
+      {"hoberman", 1, 1, "hoberman N (N >= 3)", "Hoberman-type ring; planar DOF 1 G -3 R 4"},
+      {"parallelogram_grid", 2, 2, "parallelogram_grid R C",
+       "R x C grid of continuous bars; planar DOF 1 G R+C+1-2RC R 2RC-R-C"},
+  };
+  return families;
+}
+
+GeneratorResult<GenerateRequest> parseGenerateArguments(const std::vector<std::string>& args) {
+  if (args.empty()) {
+    return GeneratorError{"missing FAMILY (try --list)"};
+  }
+  GenerateRequest request;
+  request.family = args.front();
+  const FamilyInfo* info = findFamily(request.family);
+  if (info == nullptr) {
+    return GeneratorError{"unknown family '" + request.family + "' (try --list)"};
+  }
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (!arg.empty() && arg[0] == '-' && !parseInt(arg)) {
+      const std::string key = arg.substr(arg.rfind('-') + 1);
+      if (i + 1 >= args.size()) {
+        return GeneratorError{"option '" + arg + "' needs a value"};
+      }
+      const std::string& value = args[++i];
+      if (key == "scale") {
+        const std::optional<double> scale = parseDouble(value);
+        if (!scale || *scale <= 0.0) {
+          return GeneratorError{"--scale: expected a positive number, got '" + value + "'"};
+        }
+        request.scale = *scale;
+      } else if (key == "name") {
+        if (value.empty() || value.find_first_of("\"<>&' ") != std::string::npos) {
+          return GeneratorError{"--name: '" + value + "' is not a plain robot name"};
+        }
+        request.name = value;
+      } else if (key == "visuals") {
+        if (value != "0" && value != "1") {
+          return GeneratorError{"--visuals: expected 0 or 1, got '" + value + "'"};
+        }
+        request.visuals = value == "1";
+      } else {
+        return GeneratorError{"unknown option '" + arg + "' (options: --scale, --name, --visuals)"};
+      }
+      continue;
+    }
+    const std::optional<int> count = parseInt(arg);
+    if (!count) {
+      return GeneratorError{request.family + ": expected an integer, got '" + arg + "'"};
+    }
+    request.counts.push_back(*count);
+  }
+  const int numCounts = static_cast<int>(request.counts.size());
+  if (numCounts < info->minCounts || numCounts > info->maxCounts) {
+    return GeneratorError{request.family + ": expected " + info->usage + ", got " + std::to_string(numCounts) +
+                          " count(s)"};
+  }
+  for (int count : request.counts) {
+    if (count < 1 || count > kMaxCount) {
+      return GeneratorError{request.family + ": count " + std::to_string(count) + " out of range 1.." +
+                            std::to_string(kMaxCount)};
+    }
+  }
+  return request;
+}
+
+GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& request) {
+  const std::string& family = request.family;
+  const std::vector<int>& n = request.counts;
+  MechanismDescription mechanism;
+  if (family == "four_bar") {
+    mechanism = makeFourBar();
+  } else if (family == "puma560") {
+    mechanism = makePuma560();
+  } else if (family == "parallelogram_crank") {
+    mechanism = makeParallelogramCrank();
+  } else if (family == "three_sliders") {
+    mechanism = makeThreeSliders();
+  } else if (family == "rppr") {
+    mechanism = makeRppr();
+  } else if (family == "bennett") {
+    mechanism = makeBennett();
+  } else if (family == "sarrus") {
+    mechanism = makeSarrus();
+  } else if (family == "bricard") {
+    mechanism = makeBricard();
+  } else if (family == "goldberg") {
+    mechanism = makeGoldberg();
+  } else if (family == "rssr") {
+    mechanism = makeRssr();
+  } else if (family == "sle_mast") {
+    mechanism = makeSlePlanarMast(4);
+    mechanism.name = "sle_mast";
+  } else if (family == "hoberman_ring") {
+    mechanism = makeHobermanRing(6);
+    mechanism.name = "hoberman_ring";
+  } else if (family == "door") {
+    mechanism = makeDoor(n.empty() ? 3 : n[0]);
+  } else if (family == "sle_planar") {
+    mechanism = makeSlePlanarMast(n.at(0));
+  } else if (family == "sle_spatial") {
+    mechanism = makeSleSpatialMast(n.at(0));
+  } else if (family == "hoberman") {
+    if (n.at(0) < 3) {
+      return GeneratorError{"hoberman: N must be at least 3 (a ring of fewer angulated units folds flat), got " +
+                            std::to_string(n[0])};
+    }
+    mechanism = makeHobermanRing(n[0]);
+  } else if (family == "parallelogram_grid") {
+    mechanism = makeParallelogramGrid(n.at(0), n.at(1));
+  } else {
+    return GeneratorError{"unknown family '" + family + "'"};
+  }
+  if (request.scale != 1.0) {
+    scaleMechanism(mechanism, request.scale);
+    mechanism.comment += "\nAll lengths multiplied by " + std::to_string(request.scale) + " (--scale).";
+  }
+  if (request.name) {
+    mechanism.name = *request.name;
+  }
+  return mechanism;
+}
+
+}  // namespace mobility_analysis
