@@ -18,6 +18,12 @@ namespace {
 /// Entries below this fraction of a reduced row's largest entry are rounding noise and are not stored [-].
 constexpr double kDropTolerance = 1e-15;
 
+/// An entry of a unit-norm row this small at a pivot column is cancellation noise: it is zeroed instead of
+/// eliminated. Without it, noise of 1e-17 would walk the elimination down a whole chain of links (a loop row's
+/// entries cancel exactly at the first common link, but only up to rounding). Six orders below kRank, so no rank
+/// decision can change [-].
+constexpr double kCancellationNoise = 1e-14;
+
 /// Coefficients of a dependency below this are not part of it [-] (rows are scaled to unit norm).
 constexpr double kDependencyCoefficient = 1e-9;
 
@@ -121,7 +127,10 @@ OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool c
       visited.push_back(k);
       const PivotRow& pivot = pivots[k];
       const double value = row.get(pivot.column);
-      if (value == 0.0) continue;
+      if (std::abs(value) <= kCancellationNoise) {
+        row.zero(pivot.column);
+        continue;
+      }
       const double multiplier = value / pivot.pivot;
       multipliers.emplace_back(k, multiplier);
       for (const auto& [column, entry] : pivot.entries) {

@@ -25,7 +25,7 @@ std::ostream& operator<<(std::ostream& out, const Reference& r) {
 const std::vector<Reference>& references() {
   static const std::vector<Reference> table = {
       {"four_bar.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
-      {"four_bar.urdf", AnalysisMode::Spatial, 1, -2, 3, {}, {"j4"}},
+      {"four_bar.urdf", AnalysisMode::Spatial, 1, -2, 3, {}, {"rocker_ground"}},
       {"four_bar.urdf", AnalysisMode::Auto, 1, 1, 0, {}, {}},
       {"puma560.urdf", AnalysisMode::Spatial, 6, 6, 0, {}, {}},
       {"puma560.urdf", AnalysisMode::Auto, 6, 6, 0, {}, {}},
