@@ -1,0 +1,122 @@
+#!/usr/bin/env bash
+# rviz, as a user sees it: starts launch/mobility.launch (node + rviz) under Xvfb for each model below, takes a
+# screenshot of the whole screen and asserts that an over-constrained model shows red (redundant elements, colour
+# (1, 0, 0)) and an exactly-constrained one shows none. PNGs are kept in BUILD_DIR/rviz_screenshots/.
+#
+#   test/ros/rviz_screenshot_test.sh [BUILD_DIR]      (default: build; needs a built package in BUILD_DIR/devel)
+#
+# Exit 0 when every case passes, 1 otherwise; one PASS/FAIL line per case. Starts its own Xvfb and ROS master on
+# free numbers and stops exactly those processes (by pid) on exit.
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+SOURCE_DIR=$PWD
+BUILD_DIR=$(realpath "${1:-build}")
+OUT_DIR="$BUILD_DIR/rviz_screenshots"
+mkdir -p "$OUT_DIR"
+export PATH="/usr/bin:$PATH"  # the pyenv python3 shim has no ROS modules
+# shellcheck disable=SC1091
+set +u; source "$BUILD_DIR/devel/setup.bash"; set -u
+export LIBGL_ALWAYS_SOFTWARE=1
+export ROS_HOME="$OUT_DIR/ros_home"
+
+# case name | URDF | mode | expect red (1) or none (0). MA_URDF_DIR overrides where the models are read from.
+URDF_DIR=${MA_URDF_DIR:-$SOURCE_DIR/urdf}
+CASES=(
+  "bennett|$URDF_DIR/bennett.urdf|auto|1"
+  "puma560|$URDF_DIR/puma560.urdf|auto|0"
+  "four_bar_planar|$URDF_DIR/four_bar.urdf|planar|0"
+)
+# A pixel is "red" when it is the marker red, lit or not: strong red, little green and blue. Orange (1, 0.5, 0)
+# keeps g/r = 0.5 and the neutral grey/blue colours have large g or b, so neither counts.
+RED_FX='(r > 0.35 && g < 0.12*r+0.02 && b < 0.12*r+0.02) ? 1 : 0'
+MIN_RED_PIXELS=40   # a redundant joint or link drawn at this view covers hundreds of pixels
+WAIT_SECONDS=60
+
+XVFB_PID=""
+LAUNCH_PID=""
+cleanup() {
+  [ -n "$LAUNCH_PID" ] && kill -INT "$LAUNCH_PID" 2>/dev/null && wait "$LAUNCH_PID" 2>/dev/null
+  [ -n "$XVFB_PID" ] && kill "$XVFB_PID" 2>/dev/null && wait "$XVFB_PID" 2>/dev/null
+  LAUNCH_PID=""
+  XVFB_PID=""
+}
+trap cleanup EXIT
+
+free_display() {
+  local n
+  for n in $(seq 90 140); do
+    [ -e "/tmp/.X11-unix/X$n" ] || [ -e "/tmp/.X$n-lock" ] || { echo "$n"; return; }
+  done
+  echo 99
+}
+free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])'; }
+
+failures=0
+for entry in "${CASES[@]}"; do
+  IFS='|' read -r name urdf mode expect_red <<<"$entry"
+  png="$OUT_DIR/$name.png"
+  log="$OUT_DIR/$name.log"
+  if [ ! -f "$urdf" ]; then
+    echo "FAIL rviz screenshot $name: no $urdf"
+    failures=$((failures + 1))
+    continue
+  fi
+  display=$(free_display)
+  Xvfb ":$display" -screen 0 1280x900x24 -nolisten tcp >"$OUT_DIR/$name.xvfb.log" 2>&1 &
+  XVFB_PID=$!
+  export DISPLAY=":$display"
+  for _ in $(seq 1 50); do xwininfo -root >/dev/null 2>&1 && break; sleep 0.1; done
+
+  port=$(free_port)
+  export ROS_MASTER_URI="http://localhost:$port"
+  roslaunch -p "$port" mobility_analysis mobility.launch urdf:="$urdf" mode:="$mode" rviz:=true \
+    rviz_args:="--opengl 210" >"$log" 2>&1 &
+  LAUNCH_PID=$!
+
+  # Bounded waits: the service (the node analysed and published), then the rviz window, then frames to settle.
+  ok=0
+  for _ in $(seq 1 $((WAIT_SECONDS * 2))); do
+    rosservice list 2>/dev/null | grep -q "^/mobility_server/get_dof$" && { ok=1; break; }
+    sleep 0.5
+  done
+  window=0
+  for _ in $(seq 1 $((WAIT_SECONDS * 2))); do
+    xwininfo -root -tree 2>/dev/null | grep -qi "rviz" && { window=1; break; }
+    sleep 0.5
+  done
+  # rviz draws markers once the latched array and tf arrive; wait until two screenshots 1 s apart agree.
+  previous=""
+  for _ in $(seq 1 30); do
+    sleep 1
+    import -window root "$png" 2>/dev/null || continue
+    current=$(md5sum <"$png")
+    [ "$current" = "$previous" ] && break
+    previous=$current
+  done
+
+  # Count only inside rviz's 3D view (the unnamed Ogre render window, the largest one), not the panels, whose
+  # icons have red in them. Its geometry comes from `xwininfo -tree`: "WxH+x+y  +X+Y" (absolute X, Y last).
+  view=$(xwininfo -root -tree 2>/dev/null | awk '/\(has no name\)/ && match($0, /[0-9]+x[0-9]+\+[-0-9]+\+[-0-9]+ +\+[-0-9]+\+[-0-9]+/) {
+           split(substr($0, RSTART, RLENGTH), f, /[x+ ]+/); if (f[1] * f[2] > best) { best = f[1] * f[2];
+           g = f[1] "x" f[2] "+" f[5] "+" f[6] } } END { print g }')
+  if [ -n "$view" ]; then
+    convert "$png" -crop "$view" +repage "$OUT_DIR/$name.view.png" 2>/dev/null
+  else
+    cp "$png" "$OUT_DIR/$name.view.png"
+  fi
+  red=$(convert "$OUT_DIR/$name.view.png" -fx "$RED_FX" -format '%[fx:round(mean*w*h)]' info: 2>/dev/null || echo -1)
+  cleanup
+  if [ "$ok" != 1 ] || [ "$window" != 1 ] || [ "$red" -lt 0 ]; then
+    echo "FAIL rviz screenshot $name: service=$ok window=$window red=$red (see $log)"
+    failures=$((failures + 1))
+  elif [ "$expect_red" = 1 ] && [ "$red" -lt "$MIN_RED_PIXELS" ]; then
+    echo "FAIL rviz screenshot $name: over-constrained but only $red red pixels ($png)"
+    failures=$((failures + 1))
+  elif [ "$expect_red" = 0 ] && [ "$red" -gt 0 ]; then
+    echo "FAIL rviz screenshot $name: exactly constrained but $red red pixels ($png)"
+    failures=$((failures + 1))
+  else
+    echo "PASS rviz screenshot $name: $red red pixels in the 3D view $view, expected $([ "$expect_red" = 1 ] && echo "some" || echo "none") ($png)"
+  fi
+done
+exit $((failures > 0))
