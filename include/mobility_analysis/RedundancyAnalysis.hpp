@@ -35,7 +35,9 @@ struct OrderedRank {
  * @param[in] tolerance relative threshold (tolerances::kRank by default).
  * @param[in] computeDependencies whether to compute each redundant equation's dependency.
  */
-OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies = true);
+/// @param[in] rowScale when given, row r is scaled by rowScale(r) instead of by 1 / its norm (dim J.rows()).
+OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies = true,
+                               const Eigen::VectorXd* rowScale = nullptr);
 
 /**
  * @brief Reference implementation: dense, with a rank-revealing QR of the Gram-Schmidt residual of each row.

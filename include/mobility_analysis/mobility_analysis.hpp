@@ -12,4 +12,5 @@
 #include "mobility_analysis/NaturalCoordinates.hpp"
 #include "mobility_analysis/RedundancyAnalysis.hpp"
 #include "mobility_analysis/Tolerances.hpp"
+#include "mobility_analysis/TreeMotion.hpp"
 #include "mobility_analysis/UrdfLoader.hpp"

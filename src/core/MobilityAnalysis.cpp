@@ -5,6 +5,7 @@
 #include "mobility_analysis/ConstraintJacobian.hpp"
 #include "mobility_analysis/Kinematics.hpp"
 #include "mobility_analysis/Tolerances.hpp"
+#include "mobility_analysis/TreeMotion.hpp"
 
 namespace mobility_analysis {
 
@@ -66,7 +67,10 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   const SparseJacobian J = computeConstraintJacobian(model, analysis.assembled.q);
   const double tolerance = options.rankTolerance > 0.0 ? options.rankTolerance : tolerances::kRank;
   progress("ordered rank", 0.3);
-  const OrderedRank ranks = computeOrderedRank(J, tolerance, true);
+  // The tree factored out keeps the elimination as local as the loops; the direct elimination is the fallback.
+  std::optional<OrderedRank> overTree =
+      computeOrderedRankOverTree(mechanism, model, analysis.assembled.q, J, tolerance);
+  const OrderedRank ranks = overTree ? std::move(*overTree) : computeOrderedRank(J, tolerance, true);
 
   MobilityReport& report = analysis.report;
   report.robot = mechanism.name;

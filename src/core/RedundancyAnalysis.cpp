@@ -84,7 +84,8 @@ std::vector<int> traceDependency(int row, const std::vector<std::pair<int, doubl
 
 }  // namespace
 
-OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies) {
+OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies,
+                               const Eigen::VectorXd* rowScale) {
   const int m = static_cast<int>(J.rows());
   const int n = static_cast<int>(J.cols());
   OrderedRank result;
@@ -105,7 +106,7 @@ OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool c
     // Each equation scaled to unit norm, so the threshold is relative to the equation itself.
     double norm = 0.0;
     for (SparseJacobian::InnerIterator it(J, r); it; ++it) norm += it.value() * it.value();
-    norm = std::sqrt(norm);
+    norm = rowScale != nullptr ? ((*rowScale)(r) > 0.0 ? 1.0 / (*rowScale)(r) : 0.0) : std::sqrt(norm);
     row.clear();
     multipliers.clear();
     if (norm > 0.0) {

@@ -1,0 +1,122 @@
+/// mobility_benchmark --method full|literal|dense FILE.urdf [--mode auto|planar|spatial] [--budget SECONDS]
+///
+/// Measures one method on one model in this process and prints one line:
+///   method=<m> file=<f> coordinates=<n> equations=<m> dof=<d> redundant=<r> seconds=<t> peak_mb=<p> status=<s>
+/// full:    our whole report (assembly check, Jacobian, sparse ordered rank, redundant links);
+/// literal: the lecture's algorithm, the nullity of the first k rows after each equation (ColPivHouseholderQR);
+/// dense:   one dense rank-revealing decomposition (ColPivHouseholderQR) of the same Jacobian.
+/// Peak memory is the process's maximum resident set (getrusage), so run one method per process.
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include <Eigen/Dense>
+#include <sys/resource.h>
+
+#include "mobility_analysis/mobility_analysis.hpp"
+
+using namespace mobility_analysis;
+
+namespace {
+
+double peakMegabytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+int fail(const std::string& line) {
+  std::cerr << line << std::endl;
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string method = "full", file, modeText = "auto";
+  double budget = 60.0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if ((arg == "--method" || arg == "--mode" || arg == "--budget") && i + 1 < argc) {
+      const std::string value = argv[++i];
+      if (arg == "--method") method = value;
+      if (arg == "--mode") modeText = value;
+      if (arg == "--budget") budget = std::stod(value);
+    } else if (file.empty() && arg[0] != '-') {
+      file = arg;
+    } else {
+      return fail("usage: mobility_benchmark --method full|literal|dense FILE.urdf [--mode M] [--budget S]");
+    }
+  }
+  if (file.empty() || (method != "full" && method != "literal" && method != "dense")) {
+    return fail("usage: mobility_benchmark --method full|literal|dense FILE.urdf [--mode M] [--budget S]");
+  }
+  const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
+  if (!isOk(mode)) return fail(diagnosticOf(mode).toString());
+  const Result<Mechanism> mechanism = loadMechanismFromFile(file);
+  if (!isOk(mechanism)) return fail(diagnosticOf(mechanism).toString());
+
+  const auto start = std::chrono::steady_clock::now();
+  auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  int n = 0, m = 0, dof = -1, redundant = -1;
+  std::string status = "ok";
+  if (method == "full") {
+    AnalysisOptions options;
+    options.mode = valueOf(mode);
+    const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+    if (!isOk(analysis)) return fail(diagnosticOf(analysis).toString());
+    const MobilityReport& report = valueOf(analysis).report;
+    n = report.numCoordinates;
+    m = report.numConstraints;
+    dof = report.dof;
+    redundant = report.numRedundant;
+  } else {
+    // The same Jacobian the full report uses, built outside the timed region for the baselines.
+    const Result<AssembledMechanism> assembled =
+        assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
+    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
+    const SparseJacobian J = computeConstraintJacobian(valueOf(assembled).model, valueOf(assembled).q);
+    n = static_cast<int>(J.cols());
+    m = static_cast<int>(J.rows());
+    const double denseBytes = 8.0 * n * m;
+    if (denseBytes > 8e9) {
+      status = "skipped_memory";
+    } else {
+      Eigen::MatrixXd dense = Eigen::MatrixXd(J);
+      for (int r = 0; r < m; ++r) dense.row(r) /= dense.row(r).norm();
+      const auto timed = std::chrono::steady_clock::now();
+      if (method == "dense") {
+        Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(dense);
+        qr.setThreshold(tolerances::kRank);
+        dof = n - static_cast<int>(qr.rank());
+        redundant = m - static_cast<int>(qr.rank());
+      } else {
+        // Literal: one decomposition per added equation; stop when the budget is spent.
+        int rank = 0;
+        for (int r = 0; r < m; ++r) {
+          Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(dense.topRows(r + 1));
+          qr.setThreshold(tolerances::kRank);
+          rank = static_cast<int>(qr.rank());
+          if (std::chrono::duration<double>(std::chrono::steady_clock::now() - timed).count() > budget) {
+            status = "over_budget_at_row_" + std::to_string(r);
+            break;
+          }
+        }
+        if (status == "ok") {
+          dof = n - rank;
+          redundant = m - rank;
+        }
+      }
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - timed).count();
+      std::printf("method=%s file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f peak_mb=%.1f status=%s\n",
+                  method.c_str(), file.c_str(), n, m, dof, redundant, elapsed, peakMegabytes(), status.c_str());
+      return 0;
+    }
+  }
+  std::printf("method=%s file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f peak_mb=%.1f status=%s\n",
+              method.c_str(), file.c_str(), n, m, dof, redundant, seconds(), peakMegabytes(), status.c_str());
+  return 0;
+}
