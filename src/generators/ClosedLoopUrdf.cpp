@@ -12,7 +12,8 @@
 namespace mobility_analysis {
 
 Eigen::Matrix3d rotationFromRpy(const Eigen::Vector3d& rpy) {
-  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
@@ -21,7 +22,8 @@ Eigen::Vector3d rpyFromRotation(const Eigen::Matrix3d& rotation) {
   // Taking yaw first and reading pitch and roll from Rz(-yaw)·R keeps the round trip exact to rounding
   // near pitch = ±90°, where the textbook asin/atan2 formulas lose half the digits and would open the loops.
   const double yaw = std::atan2(rotation(1, 0), rotation(0, 0));
-  const Eigen::Matrix3d rest = Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * rotation;
+  const Eigen::Matrix3d rest =
+      Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * rotation;
   // rest = Ry(pitch) Rx(roll) = [[cp, sp sr, sp cr], [0, cr, -sr], [-sp, cp sr, cp cr]]
   const double pitch = std::atan2(-rest(2, 0), rest(0, 0));
   const double roll = std::atan2(-rest(1, 2), rest(1, 1));
@@ -37,9 +39,12 @@ Eigen::Isometry3d toIsometry(const UrdfPose& pose) {
 
 namespace {
 
-constexpr double kSnapTolerance = 1e-15;  ///< Below this (relative to the model size) a coordinate is printed as 0.
+constexpr double kSnapTolerance =
+    1e-15;  ///< Below this (relative to the model size) a coordinate is printed as 0.
 
-double snap(double value, double scale) { return std::abs(value) < kSnapTolerance * scale ? 0.0 : value; }
+double snap(double value, double scale) {
+  return std::abs(value) < kSnapTolerance * scale ? 0.0 : value;
+}
 
 UrdfPose toUrdfPose(const Eigen::Isometry3d& transform, double lengthScale) {
   UrdfPose pose;
@@ -61,7 +66,9 @@ Eigen::Vector3d cleanAxis(const Eigen::Vector3d& axis) {
   return clean.normalized();
 }
 
-bool isFinite(const Eigen::Isometry3d& frame) { return frame.matrix().allFinite(); }
+bool isFinite(const Eigen::Isometry3d& frame) {
+  return frame.matrix().allFinite();
+}
 
 /// Characteristic length of the model, to make snapping relative.
 double computeLengthScale(const MechanismDescription& mechanism) {
@@ -73,7 +80,8 @@ double computeLengthScale(const MechanismDescription& mechanism) {
 }
 
 std::vector<CylinderVisual> buildVisuals(const std::vector<Eigen::Vector3d>& worldPath, bool star,
-                                         const Eigen::Isometry3d& linkFrame, double radius, double lengthScale) {
+                                         const Eigen::Isometry3d& linkFrame, double radius,
+                                         double lengthScale) {
   std::vector<CylinderVisual> cylinders;
   const Eigen::Isometry3d toLink = linkFrame.inverse();
   for (size_t i = 1; i < worldPath.size(); ++i) {
@@ -197,8 +205,8 @@ GeneratorResult<ClosedLoopLayout> computeClosedLoopLayout(const MechanismDescrip
   for (size_t c = 0; c < numConnections; ++c) {
     const Connection& connection = mechanism.connections[c];
     jointPoints[ends[c][0]].push_back(connection.frame.translation());
-    jointPoints[ends[c][1]].push_back(connection.type == ConnectionType::Distance ? connection.point2
-                                                                                   : connection.frame.translation());
+    jointPoints[ends[c][1]].push_back(
+        connection.type == ConnectionType::Distance ? connection.point2 : connection.frame.translation());
   }
   for (size_t l = 1; l < numLinks; ++l) {
     if (isFloating[l]) {
@@ -327,14 +335,15 @@ std::string buildHeaderComment(const MechanismDescription& mechanism, const Clos
   for (std::string line; std::getline(body, line);) {
     text << "  " << line << '\n';
   }
-  text << "\n  Links (incl. ground): " << mechanism.links.size() << ", joints: " << mechanism.connections.size()
-       << " (tree " << (layout.treeJoints.size()) << " incl. floating, loop " << layout.loopJoints.size()
-       << ").\n";
+  text << "\n  Links (incl. ground): " << mechanism.links.size()
+       << ", joints: " << mechanism.connections.size() << " (tree " << (layout.treeJoints.size())
+       << " incl. floating, loop " << layout.loopJoints.size() << ").\n";
   for (const FamilyExpectation& e : mechanism.expectations) {
-    text << "  Expected (" << e.mode << ", lambda " << e.lambda << "): DOF " << e.dof << ", Gruebler " << e.grubler
-         << ", redundant equations " << e.redundant << ".\n";
+    text << "  Expected (" << e.mode << ", lambda " << e.lambda << "): DOF " << e.dof << ", Gruebler "
+         << e.grubler << ", redundant equations " << e.redundant << ".\n";
   }
-  text << "  Every loop closes exactly at the written pose: both sides of each loop joint reference one world\n"
+  text << "  Every loop closes exactly at the written pose: both sides of each loop joint reference one "
+          "world\n"
           "  frame; all joint values are 0.\n";
   if (!options.generatorCommand.empty()) {
     text << "  Generated by: " << options.generatorCommand << "\n";
@@ -392,15 +401,15 @@ void writeLayout(const MechanismDescription& mechanism, const ClosedLoopLayout& 
   }
   for (const LoopJointLayout& loop : layout.loopJoints) {
     if (loop.type == ConnectionType::Distance) {
-      chunk += "  <distance_constraint name=\"" + loop.name + "\">\n    <link1 link=\"" + loop.link1 +
-               "\" xyz=\"";
+      chunk +=
+          "  <distance_constraint name=\"" + loop.name + "\">\n    <link1 link=\"" + loop.link1 + "\" xyz=\"";
       appendTriple(chunk, loop.frame1.xyz);
       chunk += "\"/>\n    <link2 link=\"" + loop.link2 + "\" xyz=\"";
       appendTriple(chunk, loop.frame2.xyz);
       chunk += "\"/>\n  </distance_constraint>\n";
     } else {
-      chunk += "  <loop_joint name=\"" + loop.name + "\" type=\"" + toString(loop.type) + "\">\n    <link1 link=\"" +
-               loop.link1 + "\" ";
+      chunk += "  <loop_joint name=\"" + loop.name + "\" type=\"" + toString(loop.type) +
+               "\">\n    <link1 link=\"" + loop.link1 + "\" ";
       appendPose(chunk, loop.frame1);
       chunk += "/>\n    <link2 link=\"" + loop.link2 + "\" ";
       appendPose(chunk, loop.frame2);

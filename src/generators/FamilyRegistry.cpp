@@ -50,8 +50,10 @@ const std::vector<FamilyInfo>& listFamilies() {
   static const std::vector<FamilyInfo> families = {
       {"four_bar", 0, 0, "four_bar", "Grashof crank-rocker; planar DOF 1 G 1 R 0, spatial DOF 1 G -2 R 3"},
       {"puma560", 0, 0, "puma560", "PUMA 560 open chain; spatial DOF 6 G 6 R 0"},
-      {"parallelogram_crank", 0, 0, "parallelogram_crank", "parallelogram + third crank pq; planar DOF 1 G 0 R 1"},
-      {"three_sliders", 0, 0, "three_sliders", "three sliders on an equilateral triangle; planar DOF 1 G 0 R 1"},
+      {"parallelogram_crank", 0, 0, "parallelogram_crank",
+       "parallelogram + third crank pq; planar DOF 1 G 0 R 1"},
+      {"three_sliders", 0, 0, "three_sliders",
+       "three sliders on an equilateral triangle; planar DOF 1 G 0 R 1"},
       {"rppr", 0, 0, "rppr", "RPPR, slides collinear with the pivots; planar DOF 1 G 1 R 0"},
       {"bennett", 0, 0, "bennett [--scale S]", "Bennett 4R; spatial DOF 1 G -2 R 3"},
       {"sarrus", 0, 0, "sarrus", "Sarrus 6R; spatial DOF 1 G 0 R 1"},
@@ -60,9 +62,10 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"rssr", 0, 0, "rssr", "RSSR, rod floating; spatial DOF 2 G 2 R 0"},
       {"sle_mast", 0, 0, "sle_mast", "= sle_planar 4"},
       {"hoberman_ring", 0, 0, "hoberman_ring", "= hoberman 6"},
-      {"door", 0, 1, "door [K=3]", "door on K coaxial hinges; spatial DOF 1 G 6-5K R 5K-5, planar G 3-2K R 2K-2"},
+      {"door", 0, 1, "door [K=3]",
+       "door on K coaxial hinges; spatial DOF 1 G 6-5K R 5K-5, planar G 3-2K R 2K-2"},
       {"sle_planar", 1, 1, "sle_planar N", "planar scissor mast, pin + slider base; planar DOF 1 G 1 R 0"},
-      {"sle_spatial", 1, 1, "sle_spatial N", "triangular scissor mast; spatial DOF 1 G 15-18N R 18N-14"},
+      {"sle_spatial", 1, 1, "sle_spatial N", "triangular scissor mast; spatial DOF 1 G 3-6N R 6N-2"},
       {"hoberman", 1, 1, "hoberman N (N >= 3)", "Hoberman-type ring; planar DOF 1 G -3 R 4"},
       {"parallelogram_grid", 2, 2, "parallelogram_grid R C",
        "R x C grid of continuous bars; planar DOF 1 G R+C+1-2RC R 2RC-R-C"},
@@ -117,8 +120,8 @@ GeneratorResult<GenerateRequest> parseGenerateArguments(const std::vector<std::s
   }
   const int numCounts = static_cast<int>(request.counts.size());
   if (numCounts < info->minCounts || numCounts > info->maxCounts) {
-    return GeneratorError{request.family + ": expected " + info->usage + ", got " + std::to_string(numCounts) +
-                          " count(s)"};
+    return GeneratorError{request.family + ": expected " + info->usage + ", got " +
+                          std::to_string(numCounts) + " count(s)"};
   }
   for (int count : request.counts) {
     if (count < 1 || count > kMaxCount) {
@@ -167,8 +170,9 @@ GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& r
     mechanism = makeSleSpatialMast(n.at(0));
   } else if (family == "hoberman") {
     if (n.at(0) < 3) {
-      return GeneratorError{"hoberman: N must be at least 3 (a ring of fewer angulated units folds flat), got " +
-                            std::to_string(n[0])};
+      return GeneratorError{
+          "hoberman: N must be at least 3 (a ring of fewer angulated units folds flat), got " +
+          std::to_string(n[0])};
     }
     mechanism = makeHobermanRing(n[0]);
   } else if (family == "parallelogram_grid") {

@@ -88,29 +88,33 @@ Connection makeAxial(std::string name, ConnectionType type, std::string link1, s
 
 Connection makeRevolute(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin,
                         const Eigen::Vector3d& axis) {
-  return makeAxial(std::move(name), ConnectionType::Revolute, std::move(link1), std::move(link2), origin, axis);
+  return makeAxial(std::move(name), ConnectionType::Revolute, std::move(link1), std::move(link2), origin,
+                   axis);
 }
 
-Connection makePrismatic(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin,
-                         const Eigen::Vector3d& axis) {
-  return makeAxial(std::move(name), ConnectionType::Prismatic, std::move(link1), std::move(link2), origin, axis);
+Connection makePrismatic(std::string name, std::string link1, std::string link2,
+                         const Eigen::Vector3d& origin, const Eigen::Vector3d& axis) {
+  return makeAxial(std::move(name), ConnectionType::Prismatic, std::move(link1), std::move(link2), origin,
+                   axis);
 }
 
-Connection makeCylindrical(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin,
-                           const Eigen::Vector3d& axis) {
+Connection makeCylindrical(std::string name, std::string link1, std::string link2,
+                           const Eigen::Vector3d& origin, const Eigen::Vector3d& axis) {
   return makeAxial(std::move(name), ConnectionType::Cylindrical, std::move(link1), std::move(link2), origin,
                    axis);
 }
 
-Connection makeSpherical(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin) {
+Connection makeSpherical(std::string name, std::string link1, std::string link2,
+                         const Eigen::Vector3d& origin) {
   return makeAxial(std::move(name), ConnectionType::Spherical, std::move(link1), std::move(link2), origin,
                    Eigen::Vector3d::UnitZ());
 }
 
-Connection makeUniversal(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin,
-                         const Eigen::Vector3d& axis1, const Eigen::Vector3d& axis2) {
-  Connection connection =
-      makeAxial(std::move(name), ConnectionType::Universal, std::move(link1), std::move(link2), origin, axis1);
+Connection makeUniversal(std::string name, std::string link1, std::string link2,
+                         const Eigen::Vector3d& origin, const Eigen::Vector3d& axis1,
+                         const Eigen::Vector3d& axis2) {
+  Connection connection = makeAxial(std::move(name), ConnectionType::Universal, std::move(link1),
+                                    std::move(link2), origin, axis1);
   connection.axis2 = axis2.normalized();
   return connection;
 }

@@ -21,7 +21,9 @@ LinkDescription link(std::string name, std::vector<Eigen::Vector3d> path = {}) {
   return description;
 }
 
-std::string indexed(const char* prefix, int i) { return prefix + std::to_string(i); }
+std::string indexed(const char* prefix, int i) {
+  return prefix + std::to_string(i);
+}
 
 }  // namespace
 
@@ -41,13 +43,15 @@ MechanismDescription makeSlePlanarMast(int units) {
 
   MechanismDescription m;
   m.name = "sle_mast_" + std::to_string(units);
-  m.comment = "Planar scissor (SLE) mast of " + std::to_string(units) +
-              " units in the x-y plane, axes along z. Unit k: bar_k_a from (0, (k-1)h) to (w, kh)\n"
-              "and bar_k_b from (w, (k-1)h) to (0, kh), pivoted at their midpoints; bars 1 m at 50 deg, w = cos 50,\n"
-              "h = sin 50. Unit k+1's feet are pinned to unit k's tops. Base: bar_1_a pinned to the ground at (0,0),\n"
-              "bar_1_b's foot pinned to a slider that slides along x on the ground. Every unit keeps the same\n"
-              "angle, so the width w (with w^2 + h^2 = 1) is the one freedom for any number of units.\n"
-              "Closed form: planar DOF 1, Gruebler 1, redundant 0; spatial DOF 1, Gruebler 1 - 3N, redundant 3N.";
+  m.comment =
+      "Planar scissor (SLE) mast of " + std::to_string(units) +
+      " units in the x-y plane, axes along z. Unit k: bar_k_a from (0, (k-1)h) to (w, kh)\n"
+      "and bar_k_b from (w, (k-1)h) to (0, kh), pivoted at their midpoints; bars 1 m at 50 deg, w = cos 50,\n"
+      "h = sin 50. Unit k+1's feet are pinned to unit k's tops. Base: bar_1_a pinned to the ground at "
+      "(0,0),\n"
+      "bar_1_b's foot pinned to a slider that slides along x on the ground. Every unit keeps the same\n"
+      "angle, so the width w (with w^2 + h^2 = 1) is the one freedom for any number of units.\n"
+      "Closed form: planar DOF 1, Gruebler 1, redundant 0; spatial DOF 1, Gruebler 1 - 3N, redundant 3N.";
   m.links.reserve(2 * units + 2);
   m.connections.reserve(3 * units + 1);
   m.links.push_back(link("ground", {point(-0.2, 0), point(w + 0.2, 0)}));
@@ -58,15 +62,19 @@ MechanismDescription makeSlePlanarMast(int units) {
     m.links.push_back(link(bar(k, 'b'), {point(w, y0), point(0, y0 + h)}));
   }
   m.connections.push_back(makeRevolute("base_pin", "ground", bar(1, 'a'), point(0, 0), z));
-  m.connections.push_back(makePrismatic("base_slide", "ground", "slider", point(w, 0), Eigen::Vector3d::UnitX()));
+  m.connections.push_back(
+      makePrismatic("base_slide", "ground", "slider", point(w, 0), Eigen::Vector3d::UnitX()));
   m.connections.push_back(makeRevolute("slider_pin", "slider", bar(1, 'b'), point(w, 0), z));
   for (int k = 1; k <= units; ++k) {
     const double y0 = (k - 1) * h;
     if (k > 1) {
-      m.connections.push_back(makeRevolute(indexed("left_pin_", k), bar(k - 1, 'b'), bar(k, 'a'), point(0, y0), z));
-      m.connections.push_back(makeRevolute(indexed("right_pin_", k), bar(k - 1, 'a'), bar(k, 'b'), point(w, y0), z));
+      m.connections.push_back(
+          makeRevolute(indexed("left_pin_", k), bar(k - 1, 'b'), bar(k, 'a'), point(0, y0), z));
+      m.connections.push_back(
+          makeRevolute(indexed("right_pin_", k), bar(k - 1, 'a'), bar(k, 'b'), point(w, y0), z));
     }
-    m.connections.push_back(makeRevolute(indexed("centre_", k), bar(k, 'a'), bar(k, 'b'), point(0.5 * w, y0 + 0.5 * h), z));
+    m.connections.push_back(
+        makeRevolute(indexed("centre_", k), bar(k, 'a'), bar(k, 'b'), point(0.5 * w, y0 + 0.5 * h), z));
   }
   m.visualRadius = 0.015;
   m.expectations = expectSlePlanarMast(units);
@@ -75,7 +83,7 @@ MechanismDescription makeSlePlanarMast(int units) {
 
 // ---------------------------------------------------------------------------------------------------------
 std::vector<FamilyExpectation> expectSleSpatialMast(int units) {
-  return {expectation("spatial", 1, 15 - 18 * units)};
+  return {expectation("spatial", 1, 3 - 6 * units)};
 }
 
 MechanismDescription makeSleSpatialMast(int units) {
@@ -94,7 +102,9 @@ MechanismDescription makeSleSpatialMast(int units) {
     // Face f spans corner f → corner f+1; its pivots are normal to the face.
     normal[f] = (corner[(f + 1) % 3] - corner[f]).cross(Eigen::Vector3d::UnitZ()).normalized();
   }
-  auto at = [&](int c, int level) { return Eigen::Vector3d(corner[c % 3] + Eigen::Vector3d(0, 0, level * h)); };
+  auto at = [&](int c, int level) {
+    return Eigen::Vector3d(corner[c % 3] + Eigen::Vector3d(0, 0, level * h));
+  };
   // Bar a of unit k on face f rises from corner f to corner f+1; bar b from corner f+1 to corner f.
   auto bar = [](int k, int f, char side) {
     return "bar_" + std::to_string(k) + "_" + std::to_string(f) + "_" + side;
@@ -105,17 +115,24 @@ MechanismDescription makeSleSpatialMast(int units) {
   m.comment =
       "Spatial scissor mast of " + std::to_string(units) +
       " units: right prism on an equilateral triangle (side w = cos 50 m, centred on the z axis).\n"
-      "Each face f (corner f -> corner f+1) is a planar scissor chain: unit k has bar_k_f_a from corner f at\n"
-      "height (k-1)h to corner f+1 at kh and bar_k_f_b the other diagonal (bars 1 m at 50 deg, h = sin 50),\n"
-      "pivoted at their midpoints about the face normal (centre_k_f); consecutive units of a face are pinned at\n"
-      "the face edges about the face normal (pin_k_f_l / pin_k_f_r). At every corner and level the two faces\n"
-      "meeting there are joined by a spherical joint (corner_l_c). bar_1_0_a is the ground; the first bar of\n"
-      "faces 1 and 2 hangs by a floating joint (those faces are held only by spherical joints).\n"
-      "Why DOF 1: identical planar units keep a face's nodes on two parallel edges, equally spaced; shared\n"
-      "corner nodes force equal unit heights, so equal widths; three faces sharing edges pairwise form a right\n"
-      "prism on an equilateral triangle of side w, w^2 + h^2 = 1 being the one freedom.\n"
-      "Closed form (N units): links 6N, joints 12N - 3 (3N centre R, 6(N-1) face pins R, 3(N+1) spherical),\n"
-      "spatial DOF 1, Gruebler 15 - 18N, redundant 18N - 14.";
+      "Each face f (corner f -> corner f+1) is a scissor chain: unit k has bar_k_f_a from corner f at "
+      "height\n"
+      "(k-1)h to corner f+1 at kh and bar_k_f_b the other diagonal (bars 1 m at 50 deg, h = sin 50), pivoted "
+      "at\n"
+      "their midpoints by a revolute about the face normal (centre_k_f), so each unit's four ends form a\n"
+      "rectangle with diagonal 1 m. Every other joint is spherical: consecutive units of a face meet at the "
+      "face\n"
+      "edges (pin_k_f_l / pin_k_f_r) and the two faces meeting at a corner are joined at every level\n"
+      "(corner_l_c). bar_1_0_a is the ground; bars held only by spherical joints hang by floating joints.\n"
+      "Why DOF 1: a face's rectangles share their horizontal edges, so a face has one width w; shared "
+      "vertical\n"
+      "edges force equal heights, so all faces have the same w and every level is an equilateral triangle "
+      "of\n"
+      "side w; opposite sides of a rectangle are parallel and equal, so level l is level l-1 translated by "
+      "h\n"
+      "along the normal of its plane: a right prism, w^2 + h^2 = 1 being the one freedom.\n"
+      "Closed form (N units): links 6N, joints 12N - 3 (3N centre R, 9N - 3 spherical),\n"
+      "spatial DOF 1, Gruebler 6(6N - 12N + 3 - 1) + 30N - 9 = 3 - 6N, redundant 6N - 2.";
   m.links.reserve(6 * units);
   m.connections.reserve(12 * units);
   for (int k = 1; k <= units; ++k) {
@@ -124,6 +141,8 @@ MechanismDescription makeSleSpatialMast(int units) {
       m.links.push_back(link(bar(k, f, 'b'), {at(f + 1, k - 1), at(f, k)}));
     }
   }
+  // Spherical rather than revolute face pins: the rectangles already keep each face planar, and three
+  // fewer equations per pin keep the model lean (redundancy 6 per unit instead of 18).
   auto addCorners = [&](int level) {
     for (int c = 0; c < 3; ++c) {
       // Corner c is the left edge of face c and the right edge of face c−1.
@@ -131,20 +150,22 @@ MechanismDescription makeSleSpatialMast(int units) {
       const int right = (c + 2) % 3;
       const std::string leftBar = level < units ? bar(level + 1, left, 'a') : bar(units, left, 'b');
       const std::string rightBar = level < units ? bar(level + 1, right, 'b') : bar(units, right, 'a');
-      m.connections.push_back(makeSpherical("corner_" + std::to_string(level) + "_" + std::to_string(c), leftBar,
-                                            rightBar, at(c, level)));
+      m.connections.push_back(makeSpherical("corner_" + std::to_string(level) + "_" + std::to_string(c),
+                                            leftBar, rightBar, at(c, level)));
     }
   };
   for (int k = 1; k <= units; ++k) {
     for (int f = 0; f < 3; ++f) {
       if (k > 1) {
         const std::string tag = std::to_string(k) + "_" + std::to_string(f);
-        m.connections.push_back(makeRevolute("pin_" + tag + "_l", bar(k - 1, f, 'b'), bar(k, f, 'a'), at(f, k - 1), normal[f]));
         m.connections.push_back(
-            makeRevolute("pin_" + tag + "_r", bar(k - 1, f, 'a'), bar(k, f, 'b'), at(f + 1, k - 1), normal[f]));
+            makeSpherical("pin_" + tag + "_l", bar(k - 1, f, 'b'), bar(k, f, 'a'), at(f, k - 1)));
+        m.connections.push_back(
+            makeSpherical("pin_" + tag + "_r", bar(k - 1, f, 'a'), bar(k, f, 'b'), at(f + 1, k - 1)));
       }
-      m.connections.push_back(makeRevolute("centre_" + std::to_string(k) + "_" + std::to_string(f), bar(k, f, 'a'),
-                                           bar(k, f, 'b'), 0.5 * (at(f, k - 1) + at(f + 1, k)), normal[f]));
+      m.connections.push_back(makeRevolute("centre_" + std::to_string(k) + "_" + std::to_string(f),
+                                           bar(k, f, 'a'), bar(k, f, 'b'),
+                                           0.5 * (at(f, k - 1) + at(f + 1, k)), normal[f]));
     }
     addCorners(k - 1);
   }
@@ -192,9 +213,12 @@ MechanismDescription makeHobermanRing(int units) {
       "Hoberman-type ring of " + std::to_string(units) +
       " angulated scissor units in the x-y plane, axes along z. Each bar has two arms of 0.5 m meeting at\n"
       "its kink; both bars of a unit are bent the same way: u2 = -Rot(kappa) u1, v2 = -Rot(kappa) v1,\n"
-      "kappa = 360/N deg, so A2 - B2 = Rot(kappa) (B1 - A1) for every opening angle and the rotation by kappa\n"
-      "about a point O maps unit j onto unit j+1: the ring closes for every opening (written at 70 deg between\n"
-      "the first arms). Unit j: kink_j pins bar_j_a and bar_j_b; pin_j_ab pins bar_j_a's end 2 to bar_(j+1)_b's\n"
+      "kappa = 360/N deg, so A2 - B2 = Rot(kappa) (B1 - A1) for every opening angle and the rotation by "
+      "kappa\n"
+      "about a point O maps unit j onto unit j+1: the ring closes for every opening (written at 70 deg "
+      "between\n"
+      "the first arms). Unit j: kink_j pins bar_j_a and bar_j_b; pin_j_ab pins bar_j_a's end 2 to "
+      "bar_(j+1)_b's\n"
       "end 1, pin_j_ba bar_j_b's end 2 to bar_(j+1)_a's end 1. bar_0_a is the ground.\n"
       "Closed form: planar DOF 1, Gruebler 3(2N - 3N - 1) + 3N = -3, redundant 4; spatial DOF 1,\n"
       "Gruebler -3N - 6, redundant 3N + 7.";
@@ -206,9 +230,12 @@ MechanismDescription makeHobermanRing(int units) {
   }
   for (int j = 0; j < units; ++j) {
     const int next = (j + 1) % units;
-    m.connections.push_back(makeRevolute(indexed("kink_", j), bar(j, 'a'), bar(j, 'b'), place(j, Eigen::Vector2d::Zero()), z));
-    m.connections.push_back(makeRevolute(indexed("pin_ab_", j), bar(j, 'a'), bar(next, 'b'), place(j, a2), z));
-    m.connections.push_back(makeRevolute(indexed("pin_ba_", j), bar(j, 'b'), bar(next, 'a'), place(j, b2), z));
+    m.connections.push_back(
+        makeRevolute(indexed("kink_", j), bar(j, 'a'), bar(j, 'b'), place(j, Eigen::Vector2d::Zero()), z));
+    m.connections.push_back(
+        makeRevolute(indexed("pin_ab_", j), bar(j, 'a'), bar(next, 'b'), place(j, a2), z));
+    m.connections.push_back(
+        makeRevolute(indexed("pin_ba_", j), bar(j, 'b'), bar(next, 'a'), place(j, b2), z));
   }
   m.visualRadius = 0.015;
   m.expectations = expectHobermanRing(units);
@@ -234,16 +261,18 @@ MechanismDescription makeDoor(int hinges) {
 
   MechanismDescription m;
   m.name = hinges == 3 ? "door" : "door_" + std::to_string(hinges);
-  m.comment = "Door (0.9 m x 2 m) on " + std::to_string(hinges) +
-              " coaxial hinges along the world z axis, opened 40 deg; hinge_1 is the tree revolute, the others\n"
-              "are loop revolutes on the same line. Every revolute axis is parallel (auto mode picks planar).\n"
-              "Closed form (K hinges): spatial DOF 1, Gruebler 6(2 - K - 1) + K = 6 - 5K, redundant 5K - 5;\n"
-              "planar DOF 1, Gruebler 3 - 2K, redundant 2K - 2.";
+  m.comment =
+      "Door (0.9 m x 2 m) on " + std::to_string(hinges) +
+      " coaxial hinges along the world z axis, opened 40 deg; hinge_1 is the tree revolute, the others\n"
+      "are loop revolutes on the same line. Every revolute axis is parallel (auto mode picks planar).\n"
+      "Closed form (K hinges): spatial DOF 1, Gruebler 6(2 - K - 1) + K = 6 - 5K, redundant 5K - 5;\n"
+      "planar DOF 1, Gruebler 3 - 2K, redundant 2K - 2.";
   m.links.push_back(link("ground", {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 0, doorHeight),
                                     Eigen::Vector3d(0, -0.1, doorHeight)}));
-  m.links.push_back(link("door", {Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 0, doorHeight - 0.05),
-                                  doorWidth * across + Eigen::Vector3d(0, 0, doorHeight - 0.05),
-                                  doorWidth * across + Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 0, 0.05)}));
+  m.links.push_back(
+      link("door", {Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 0, doorHeight - 0.05),
+                    doorWidth * across + Eigen::Vector3d(0, 0, doorHeight - 0.05),
+                    doorWidth * across + Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 0, 0.05)}));
   for (int k = 0; k < hinges; ++k) {
     m.connections.push_back(makeRevolute(indexed("hinge_", k + 1), "ground", "door", hingePoint(k), z));
   }
@@ -268,14 +297,15 @@ MechanismDescription makeParallelogramGrid(int rows, int columns) {
 
   MechanismDescription m;
   m.name = "parallelogram_grid_" + std::to_string(rows) + "x" + std::to_string(columns);
-  m.comment = "Planar grid of " + std::to_string(rows) + " x " + std::to_string(columns) +
-              " congruent parallelogram cells (sides 0.5 m along x and 0.4 m at 70 deg), x-y plane, axes along z,\n"
-              "made of continuous bars: row_i (i = 0..R, row_0 is the ground) and col_j (j = 0..C), pinned where\n"
-              "they cross (pin_i_j). Row bars are rigid and every cell a parallelogram, so all row bars stay\n"
-              "parallel to the ground and all column bars parallel to each other: the shear angle is the one\n"
-              "freedom. Links R + C + 2, joints (R+1)(C+1).\n"
-              "Closed form: planar DOF 1, Gruebler R + C + 1 - 2RC, redundant 2RC - R - C;\n"
-              "spatial DOF 1, Gruebler R + C + 1 - 5RC, redundant 5RC - R - C.";
+  m.comment =
+      "Planar grid of " + std::to_string(rows) + " x " + std::to_string(columns) +
+      " congruent parallelogram cells (sides 0.5 m along x and 0.4 m at 70 deg), x-y plane, axes along z,\n"
+      "made of continuous bars: row_i (i = 0..R, row_0 is the ground) and col_j (j = 0..C), pinned where\n"
+      "they cross (pin_i_j). Row bars are rigid and every cell a parallelogram, so all row bars stay\n"
+      "parallel to the ground and all column bars parallel to each other: the shear angle is the one\n"
+      "freedom. Links R + C + 2, joints (R+1)(C+1).\n"
+      "Closed form: planar DOF 1, Gruebler R + C + 1 - 2RC, redundant 2RC - R - C;\n"
+      "spatial DOF 1, Gruebler R + C + 1 - 5RC, redundant 5RC - R - C.";
   for (int i = 0; i <= rows; ++i) {
     m.links.push_back(link(indexed("row_", i), {node(i, 0), node(i, columns)}));
   }
@@ -285,8 +315,8 @@ MechanismDescription makeParallelogramGrid(int rows, int columns) {
   m.links[0].name = "row_0";
   for (int i = 0; i <= rows; ++i) {
     for (int j = 0; j <= columns; ++j) {
-      m.connections.push_back(makeRevolute("pin_" + std::to_string(i) + "_" + std::to_string(j), indexed("row_", i),
-                                           indexed("col_", j), node(i, j), z));
+      m.connections.push_back(makeRevolute("pin_" + std::to_string(i) + "_" + std::to_string(j),
+                                           indexed("row_", i), indexed("col_", j), node(i, j), z));
     }
   }
   m.visualRadius = 0.012;

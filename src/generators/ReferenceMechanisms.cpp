@@ -11,9 +11,13 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-Eigen::Vector3d planar(double x, double y) { return {x, y, 0.0}; }
+Eigen::Vector3d planar(double x, double y) {
+  return {x, y, 0.0};
+}
 
-Eigen::Vector3d unitCircle(double angle) { return {std::cos(angle), std::sin(angle), 0.0}; }
+Eigen::Vector3d unitCircle(double angle) {
+  return {std::cos(angle), std::sin(angle), 0.0};
+}
 
 /**
  * Intersection of the circles (c0, r0) and (c1, r1) in the x–y plane, on the left of c0 → c1 when
@@ -50,8 +54,8 @@ double bennettSecondAngle(double alpha1, double alpha2, double theta1) {
 }
 
 /// The four joint frames F0..F3 (joint i on z of F_{i-1}) of a Bennett loop starting at @p base.
-std::array<Eigen::Isometry3d, 5> bennettFrames(const Eigen::Isometry3d& base, double a1, double alpha1, double a2,
-                                               double alpha2, double theta1) {
+std::array<Eigen::Isometry3d, 5> bennettFrames(const Eigen::Isometry3d& base, double a1, double alpha1,
+                                               double a2, double alpha2, double theta1) {
   const double theta2 = bennettSecondAngle(alpha1, alpha2, theta1);
   std::array<Eigen::Isometry3d, 5> frames;
   frames[0] = base;
@@ -93,7 +97,8 @@ MechanismDescription makeFourBar(double crankAngle) {
   m.name = "four_bar";
   m.comment =
       "Planar Grashof crank-rocker in the x-y plane, all axes along z. Ground A(0,0)-D(1,0), crank AB 0.35,\n"
-      "coupler BC 1.1, rocker CD 0.8 [m]: shortest + longest = 1.45 < 1.8 = sum of the others, the crank is the\n"
+      "coupler BC 1.1, rocker CD 0.8 [m]: shortest + longest = 1.45 < 1.8 = sum of the others, the crank is "
+      "the\n"
       "shortest link, so it turns fully. Crank at 60 deg; C is the open-branch intersection of the circles\n"
       "(B, 1.1) and (D, 0.8). The loop is closed by loop joint rocker_ground.";
   m.links = {link("ground", {p(a), p(d)}), link("crank", {p(a), p(b)}), link("coupler", {p(b), p(c)}),
@@ -118,7 +123,8 @@ MechanismDescription makePuma560() {
   m.comment =
       "PUMA 560, open chain, standard DH A_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i):\n"
       "a = (0, 0.4318, 0.0203, 0, 0, 0), d = (0, 0, 0.15005, 0.4318, 0, 0) [m],\n"
-      "alpha = (-90, 0, -90, 90, -90, 0) deg, posed at theta = (20, -35, 50, 30, -40, 15) deg (baked into the\n"
+      "alpha = (-90, 0, -90, 90, -90, 0) deg, posed at theta = (20, -35, 50, 30, -40, 15) deg (baked into "
+      "the\n"
       "joint origins; joint values in the file are 0). Joint i turns about z of DH frame i-1.";
   m.visualRadius = 0.02;
   m.links.push_back(link("base"));
@@ -132,8 +138,9 @@ MechanismDescription makePuma560() {
       path.push_back(next * Eigen::Vector3d(0.0, 0.0, 0.06));
     }
     m.links.push_back(link(name, path));
-    Connection joint = makeRevolute("joint" + std::to_string(i + 1), i == 0 ? "base" : "link" + std::to_string(i),
-                                    name, previous.translation(), previous.linear().col(2));
+    Connection joint =
+        makeRevolute("joint" + std::to_string(i + 1), i == 0 ? "base" : "link" + std::to_string(i), name,
+                     previous.translation(), previous.linear().col(2));
     // The joint frame turns with link i, so each URDF origin reads Tz(d) Tx(a) Rx(α) Rz(θ_next).
     joint.frame = previous * Eigen::AngleAxisd(theta[i], Eigen::Vector3d::UnitZ());
     m.connections.push_back(joint);
@@ -157,7 +164,8 @@ MechanismDescription makeParallelogramCrank() {
   m.name = "parallelogram_crank";
   m.comment =
       "Parallelogram with a third crank (the lecture's example), x-y plane, axes along z. Ground pivots\n"
-      "(0,0), (0.5,0), (1,0); three equal parallel cranks crank_a, pq, crank_b of 0.4 m at 65 deg; the coupler\n"
+      "(0,0), (0.5,0), (1,0); three equal parallel cranks crank_a, pq, crank_b of 0.4 m at 65 deg; the "
+      "coupler\n"
       "joins their tips, so it is the ground translated by the crank vector at every crank angle.\n"
       "Any one of the three cranks can be removed without changing the motion: link pq is redundant.";
   m.links = {link("ground", {a0, b0}), link("crank_a", {a0, a0 + e}), link("crank_b", {b0, b0 + e}),
@@ -205,15 +213,18 @@ MechanismDescription makeRppr() {
   MechanismDescription m;
   m.name = "rppr";
   m.comment =
-      "RPPR in the x-y plane: link1 pinned to the ground at A(0,0), link3 at D(1,0); the middle link2 slides on\n"
-      "link1 at (0.35,0) and on link3 at (0.65,0), both slides along x, i.e. collinear with AD. Both slide lines\n"
-      "of link2 must pass through A and D, so the cranks are locked and link2 slides along AD: DOF 1 (passive\n"
+      "RPPR in the x-y plane: link1 pinned to the ground at A(0,0), link3 at D(1,0); the middle link2 slides "
+      "on\n"
+      "link1 at (0.35,0) and on link3 at (0.65,0), both slides along x, i.e. collinear with AD. Both slide "
+      "lines\n"
+      "of link2 must pass through A and D, so the cranks are locked and link2 slides along AD: DOF 1 "
+      "(passive\n"
       "slide), Gruebler 1, nothing redundant.";
   m.links = {link("ground", {a, d}), link("link1", {a, s1}), link("link2", {s1 - 0.1 * x, s2 + 0.1 * x}),
              link("link3", {s2, d})};
-  m.connections = {makeRevolute("pivot_a", "ground", "link1", a, z),
-                   makePrismatic("slide_1", "link1", "link2", s1, x),
-                   makePrismatic("slide_2", "link2", "link3", s2, x), makeRevolute("pivot_d", "link3", "ground", d, z)};
+  m.connections = {
+      makeRevolute("pivot_a", "ground", "link1", a, z), makePrismatic("slide_1", "link1", "link2", s1, x),
+      makePrismatic("slide_2", "link2", "link3", s2, x), makeRevolute("pivot_d", "link3", "ground", d, z)};
   m.expectations = {expectation("planar", 1, 1), expectation("spatial", 1, -2)};
   return m;
 }
@@ -223,7 +234,8 @@ MechanismDescription makeBennett(double scale, double theta1) {
   const double alpha = 40 * kDeg;
   const double beta = 70 * kDeg;
   const double b = a * std::sin(beta) / std::sin(alpha);
-  const std::array<Eigen::Isometry3d, 5> f = bennettFrames(Eigen::Isometry3d::Identity(), a, alpha, b, beta, theta1);
+  const std::array<Eigen::Isometry3d, 5> f =
+      bennettFrames(Eigen::Isometry3d::Identity(), a, alpha, b, beta, theta1);
   const double theta2 = bennettSecondAngle(alpha, beta, theta1);
   const std::array<double, 4> theta = {theta1, theta2, -theta1, -theta2};
   const std::array<const char*, 4> names = {"ground", "link1", "link2", "link3"};
@@ -231,12 +243,14 @@ MechanismDescription makeBennett(double scale, double theta1) {
   MechanismDescription m;
   m.name = scale == 1.0 ? "bennett" : "bennett_scaled";
   m.comment =
-      "Bennett 4R. Standard DH A_i = Rz(theta_i) Tx(a_i) Rx(alpha_i), offsets 0, links (a, alpha), (b, beta),\n"
+      "Bennett 4R. Standard DH A_i = Rz(theta_i) Tx(a_i) Rx(alpha_i), offsets 0, links (a, alpha), (b, "
+      "beta),\n"
       "(a, alpha), (b, beta) with a = 0.6 m, alpha = 40 deg, beta = 70 deg, b = a sin(beta)/sin(alpha) = " +
       std::to_string(b) +
       " m.\n"
       "Closure (checked numerically, the convention of the contract holds as written):\n"
-      "tan(theta1/2) tan(theta2/2) = sin((beta+alpha)/2) / sin((beta-alpha)/2), theta3 = -theta1, theta4 = -theta2;\n"
+      "tan(theta1/2) tan(theta2/2) = sin((beta+alpha)/2) / sin((beta-alpha)/2), theta3 = -theta1, theta4 = "
+      "-theta2;\n"
       "theta1 = " +
       std::to_string(theta1 / kDeg) + " deg, theta2 = " + std::to_string(theta2 / kDeg) +
       " deg. Joint j(i) turns about z of DH frame i-1;\n"
@@ -248,8 +262,8 @@ MechanismDescription makeBennett(double scale, double theta1) {
     m.links.push_back(link(names[i], {f[(i + 3) % 4].translation(), f[i].translation()}));
   }
   for (int i = 0; i < 4; ++i) {
-    Connection joint = makeRevolute("j" + std::to_string(i + 1), names[i], names[(i + 1) % 4], f[i].translation(),
-                                    f[i].linear().col(2));
+    Connection joint = makeRevolute("j" + std::to_string(i + 1), names[i], names[(i + 1) % 4],
+                                    f[i].translation(), f[i].linear().col(2));
     joint.frame = f[i] * Eigen::AngleAxisd(theta[i], Eigen::Vector3d::UnitZ());
     m.connections.push_back(joint);
   }
@@ -277,13 +291,15 @@ MechanismDescription makeSarrus(double height) {
   MechanismDescription m;
   m.name = "sarrus";
   m.comment =
-      "Sarrus 6R. Ground and top plate joined by limb A (hinges along x at (0,-0.5,0), knee, (0,-0.5,h); links\n"
+      "Sarrus 6R. Ground and top plate joined by limb A (hinges along x at (0,-0.5,0), knee, (0,-0.5,h); "
+      "links\n"
       "0.55 and 0.65 m) and limb B (hinges along y at (0.5,0,0), knee, (0.5,0,h); links 0.6 and 0.6 m),\n"
-      "h = 0.8 m, knees bent outwards. Limb A lets the plate move in y-z and turn about x, limb B in x-z and\n"
+      "h = 0.8 m, knees bent outwards. Limb A lets the plate move in y-z and turn about x, limb B in x-z "
+      "and\n"
       "about y: only the translation along z is common, for any h. Loop closed by loop joint limb_b_ground.";
-  m.links = {link("ground", {groundA, groundB}), link("limb_a_lower", {groundA, kneeA}),
-             link("limb_a_upper", {kneeA, topA}), link("top", {topA, topB}), link("limb_b_upper", {topB, kneeB}),
-             link("limb_b_lower", {kneeB, groundB})};
+  m.links = {link("ground", {groundA, groundB}),  link("limb_a_lower", {groundA, kneeA}),
+             link("limb_a_upper", {kneeA, topA}), link("top", {topA, topB}),
+             link("limb_b_upper", {topB, kneeB}), link("limb_b_lower", {kneeB, groundB})};
   m.connections = {makeRevolute("limb_a_ground", "ground", "limb_a_lower", groundA, ex),
                    makeRevolute("limb_a_knee", "limb_a_lower", "limb_a_upper", kneeA, ex),
                    makeRevolute("limb_a_top", "limb_a_upper", "top", topA, ex),
@@ -317,9 +333,12 @@ MechanismDescription makeBricard() {
   m.name = "bricard";
   m.comment =
       "Line-symmetric Bricard 6R. Joint lines (point; direction, normalised):\n"
-      "L1 (1, 0.2, 0.1; 0.3, 0.9, 0.4), L2 (0.4, 1.1, 0.6; -0.8, 0.2, 0.5), L3 (-0.6, 0.7, 1.1; 0.2, -0.5, 0.9),\n"
-      "L4..L6 = images of L1..L3 under the half-turn about the z axis, (x, y, z) -> (-x, -y, z). A 6R loop that\n"
-      "is line-symmetric is mobile (Bricard): the symmetric motion keeps the loop closed. Joint i joins link\n"
+      "L1 (1, 0.2, 0.1; 0.3, 0.9, 0.4), L2 (0.4, 1.1, 0.6; -0.8, 0.2, 0.5), L3 (-0.6, 0.7, 1.1; 0.2, -0.5, "
+      "0.9),\n"
+      "L4..L6 = images of L1..L3 under the half-turn about the z axis, (x, y, z) -> (-x, -y, z). A 6R loop "
+      "that\n"
+      "is line-symmetric is mobile (Bricard): the symmetric motion keeps the loop closed. Joint i joins "
+      "link\n"
       "i-1 and link i (link 0 = ground); loop closed by loop joint j6.";
   // Joint i+1 (on points[i]) joins link i and link i+1: link i spans points[i-1] → points[i].
   for (int i = 0; i < 6; ++i) {
@@ -344,7 +363,8 @@ MechanismDescription makeGoldberg(double theta1) {
   const double c = std::sin(gamma) / k;
   const double delta = 50 * kDeg;
   // Loop I: L (b, β), A1 (a, α), B1 (b, β), C1 (a, α). Loop II shares L's frames F0 (turned by δ) and F1.
-  const std::array<Eigen::Isometry3d, 5> f1 = bennettFrames(Eigen::Isometry3d::Identity(), b, beta, a, alpha, theta1);
+  const std::array<Eigen::Isometry3d, 5> f1 =
+      bennettFrames(Eigen::Isometry3d::Identity(), b, beta, a, alpha, theta1);
   const Eigen::Isometry3d base2 = Eigen::Isometry3d(Eigen::AngleAxisd(delta, Eigen::Vector3d::UnitZ()));
   const std::array<Eigen::Isometry3d, 5> f2 = bennettFrames(base2, b, beta, c, gamma, theta1 - delta);
   assert((f1[1].matrix() - f2[1].matrix()).norm() < 1e-12 && "the two Bennett loops must share link L");
@@ -354,9 +374,11 @@ MechanismDescription makeGoldberg(double theta1) {
   m.comment =
       "Goldberg 5R from two Bennett linkages sharing link L = (b, beta) and its two joints (standard DH\n"
       "Rz(theta) Tx(a) Rx(alpha), offsets 0). Bennett I: L, A1 (a, alpha), B1 (b, beta), C1 (a, alpha);\n"
-      "Bennett II: L, A2 (c, gamma), B2 (b, beta), C2 (c, gamma); sin(alpha)/a = sin(beta)/b = sin(gamma)/c,\n"
+      "Bennett II: L, A2 (c, gamma), B2 (b, beta), C2 (c, gamma); sin(alpha)/a = sin(beta)/b = "
+      "sin(gamma)/c,\n"
       "a = 0.6 m, alpha = 40, beta = 70, gamma = 55 deg. Loop II's first frame is loop I's turned by\n"
-      "delta = 50 deg about joint 1 (theta1' = theta1 - delta), so C1 and C2 keep their relative pose and are\n"
+      "delta = 50 deg about joint 1 (theta1' = theta1 - delta), so C1 and C2 keep their relative pose and "
+      "are\n"
       "fused into the ground; L is removed; A1 and A2 keep the revolute about L's second joint.\n"
       "Links: ground (C1+C2), b1, a1, a2, b2; loop closed by loop joint g5. theta1 = " +
       std::to_string(theta1 / kDeg) + " deg.";
@@ -392,16 +414,17 @@ MechanismDescription makeRssr() {
   m.comment =
       "RSSR. Ground revolute 1: axis z through (0,0,0), crank1 to S1 = (0.3 cos 50, 0.3 sin 50, 0.1);\n"
       "ground revolute 2: axis x through (0,1,0.35) (skew to axis 1, distance 1 m), crank2 to\n"
-      "S2 = (0.15, 1 + 0.4 cos 120, 0.35 + 0.4 sin 120) [m]. The rod S1-S2 is held only by the two spherical loop\n"
+      "S2 = (0.15, 1 + 0.4 cos 120, 0.35 + 0.4 sin 120) [m]. The rod S1-S2 is held only by the two spherical "
+      "loop\n"
       "joints and hangs from the ground by a floating joint (which constrains nothing). DOF 2: the crank\n"
       "motion and the rod's spin about S1-S2.";
   LinkDescription rod = link("rod", {s1, s2});
   rod.floatingFrame = frameFromAxis(s1, s2 - s1);
-  m.links = {link("ground", {o1, o1 + 0.2 * axis1, o2, o2 + 0.2 * axis2}), link("crank1", {o1, o1 + 0.1 * axis1, s1}),
-             link("crank2", {o2, o2 + 0.15 * axis2, s2}), rod};
+  m.links = {link("ground", {o1, o1 + 0.2 * axis1, o2, o2 + 0.2 * axis2}),
+             link("crank1", {o1, o1 + 0.1 * axis1, s1}), link("crank2", {o2, o2 + 0.15 * axis2, s2}), rod};
   m.connections = {makeRevolute("r1", "ground", "crank1", o1, axis1),
-                   makeRevolute("r2", "ground", "crank2", o2, axis2), makeSpherical("s1", "crank1", "rod", s1),
-                   makeSpherical("s2", "rod", "crank2", s2)};
+                   makeRevolute("r2", "ground", "crank2", o2, axis2),
+                   makeSpherical("s1", "crank1", "rod", s1), makeSpherical("s2", "rod", "crank2", s2)};
   m.visualRadius = 0.015;
   m.expectations = {expectation("spatial", 2, 2)};
   return m;

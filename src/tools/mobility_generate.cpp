@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
       std::cerr << "mobility_generate: " << error->what << '\n';
       return 2;
     }
-    const GeneratorResult<MechanismDescription> mechanism = generateMechanism(std::get<GenerateRequest>(request));
+    const GeneratorResult<MechanismDescription> mechanism =
+        generateMechanism(std::get<GenerateRequest>(request));
     if (const auto* error = std::get_if<GeneratorError>(&mechanism)) {
       std::cerr << "mobility_generate: " << error->what << '\n';
       return 2;

@@ -72,7 +72,8 @@ double maxClosureError(const MechanismDescription& mechanism, const ClosedLoopLa
   }
   double worst = 0;
   for (size_t l = 0; l < layout.links.size(); ++l) {
-    worst = std::max(worst, (frames.at(layout.links[l]).matrix() - layout.linkFrames[l].matrix()).cwiseAbs().maxCoeff());
+    worst = std::max(
+        worst, (frames.at(layout.links[l]).matrix() - layout.linkFrames[l].matrix()).cwiseAbs().maxCoeff());
   }
   std::unordered_map<std::string, const Connection*> connections;
   for (const Connection& c : mechanism.connections) {
@@ -145,7 +146,8 @@ TEST(ClosedLoopUrdf, EveryFamilyWritesWellFormedXml) {
     int joints = 0;
     int loops = 0;
     std::unordered_map<std::string, int> parentsOf;
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e != nullptr;
+         e = e->NextSiblingElement()) {
       const std::string tag = e->Name();
       if (tag == "link") {
         ++links;
@@ -186,7 +188,8 @@ TEST(Expectations, ClosedFormsAtLargeCounts) {
   EXPECT_EQ(*computeGrublerCount(makeSlePlanarMast(40), 3), 1);
   EXPECT_EQ(*computeGrublerCount(makeHobermanRing(40), 3), -3);
   EXPECT_EQ(*computeGrublerCount(makeDoor(12), 6), 6 - 5 * 12);
-  EXPECT_EQ(*computeGrublerCount(makeParallelogramGrid(7, 5), 3), expectParallelogramGrid(7, 5).front().grubler);
+  EXPECT_EQ(*computeGrublerCount(makeParallelogramGrid(7, 5), 3),
+            expectParallelogramGrid(7, 5).front().grubler);
 }
 
 TEST(Mobility, JacobianNullityIsTheExpectedDof) {
@@ -304,7 +307,8 @@ TEST(ClosedLoopUrdf, BennettIsClosedByJ4) {
 }
 
 TEST(ClosedLoopUrdf, LargeModelsStayClosed) {
-  for (const MechanismDescription& m : {makeSlePlanarMast(3000), makeSleSpatialMast(1000), makeHobermanRing(2000)}) {
+  for (const MechanismDescription& m :
+       {makeSlePlanarMast(3000), makeSleSpatialMast(1000), makeHobermanRing(2000)}) {
     const auto layout = computeClosedLoopLayout(m, UrdfWriterOptions{false, ""});
     ASSERT_TRUE(std::holds_alternative<ClosedLoopLayout>(layout)) << m.name;
     // Rounding accumulates along a tree thousands of joints deep; relative to the model size it stays tiny.
@@ -322,7 +326,8 @@ TEST(FamilyRegistry, EveryFamilyGenerates) {
     ASSERT_TRUE(std::holds_alternative<GenerateRequest>(request)) << info.name;
     const auto mechanism = generateMechanism(std::get<GenerateRequest>(request));
     ASSERT_TRUE(std::holds_alternative<MechanismDescription>(mechanism)) << info.name;
-    EXPECT_TRUE(std::holds_alternative<std::string>(toClosedLoopUrdf(std::get<MechanismDescription>(mechanism))));
+    EXPECT_TRUE(
+        std::holds_alternative<std::string>(toClosedLoopUrdf(std::get<MechanismDescription>(mechanism))));
   }
 }
 
@@ -349,7 +354,8 @@ TEST(FamilyRegistry, RejectsBadArguments) {
 
 TEST(MobilityGenerateCli, BadArgumentsExitTwo) {
   const std::string exe = MA_GENERATE_EXE;
-  for (const std::string args : {"", "no_such_family", "sle_spatial", "sle_spatial -4", "door 2 --visuals 7"}) {
+  for (const std::string args :
+       {"", "no_such_family", "sle_spatial", "sle_spatial -4", "door 2 --visuals 7"}) {
     const int status = std::system((exe + " " + args + " > /dev/null 2>&1").c_str());
     ASSERT_TRUE(WIFEXITED(status)) << args;
     EXPECT_EQ(WEXITSTATUS(status), 2) << args;

@@ -64,7 +64,8 @@ class MotionCheck {
           r.push_back(v(k));
         }
       };
-      const Eigen::Matrix<double, 9, 1> dr = Eigen::Map<const Eigen::Matrix<double, 9, 1>>((ri - rj).eval().data());
+      const Eigen::Matrix<double, 9, 1> dr =
+          Eigen::Map<const Eigen::Matrix<double, 9, 1>>((ri - rj).eval().data());
       switch (c.type) {
         case ConnectionType::Revolute:
         case ConnectionType::Continuous:
@@ -185,7 +186,8 @@ class MotionCheck {
         if (r.norm() < 1e-14) {
           break;
         }
-        Eigen::JacobiSVD<Eigen::MatrixXd> corrector(jacobian(poses), Eigen::ComputeThinU | Eigen::ComputeThinV);
+        Eigen::JacobiSVD<Eigen::MatrixXd> corrector(jacobian(poses),
+                                                    Eigen::ComputeThinU | Eigen::ComputeThinV);
         corrector.setThreshold(1e-8);
         poses = apply(poses, -corrector.solve(r));
       }

@@ -53,17 +53,17 @@ struct CylinderVisual {
  */
 struct ClosedLoopLayout {
   std::string robotName;
-  std::vector<std::string> links;                     ///< Document order; links.front() is the root.
-  std::vector<Eigen::Isometry3d> linkFrames;          ///< World frame of each link at the written pose.
-  std::vector<std::vector<CylinderVisual>> visuals;   ///< Per link (parallel to links).
-  std::vector<TreeJointLayout> treeJoints;            ///< Parents before children.
-  std::vector<LoopJointLayout> loopJoints;            ///< Connection order.
+  std::vector<std::string> links;                    ///< Document order; links.front() is the root.
+  std::vector<Eigen::Isometry3d> linkFrames;         ///< World frame of each link at the written pose.
+  std::vector<std::vector<CylinderVisual>> visuals;  ///< Per link (parallel to links).
+  std::vector<TreeJointLayout> treeJoints;           ///< Parents before children.
+  std::vector<LoopJointLayout> loopJoints;           ///< Connection order.
 };
 
 /// Options of the URDF writer.
 struct UrdfWriterOptions {
-  bool visuals = true;          ///< Emit `<visual>` cylinders so rviz's RobotModel shows the links.
-  std::string generatorCommand; ///< Written into the header comment ("mobility_generate bennett").
+  bool visuals = true;           ///< Emit `<visual>` cylinders so rviz's RobotModel shows the links.
+  std::string generatorCommand;  ///< Written into the header comment ("mobility_generate bennett").
 };
 
 /**

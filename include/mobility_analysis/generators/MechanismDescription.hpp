@@ -15,7 +15,16 @@ namespace mobility_analysis {
  * Revolute, Continuous, Prismatic and Fixed can become URDF tree `<joint>`s; every other kind is
  * always written as a `<loop_joint>` (or `<distance_constraint>` for Distance).
  */
-enum class ConnectionType { Revolute, Continuous, Prismatic, Cylindrical, Spherical, Universal, Fixed, Distance };
+enum class ConnectionType {
+  Revolute,
+  Continuous,
+  Prismatic,
+  Cylindrical,
+  Spherical,
+  Universal,
+  Fixed,
+  Distance
+};
 
 /// @return The dialect's type name ("revolute", …, "distance").
 const char* toString(ConnectionType type);
@@ -38,21 +47,26 @@ std::optional<int> connectionFreedom(ConnectionType type, int lambda);
  * the writer expresses `frame` once in link1's frame and once in link2's frame.
  */
 struct Connection {
-  std::string name;                                       ///< Unique among connections.
+  std::string name;  ///< Unique among connections.
   ConnectionType type = ConnectionType::Revolute;
-  std::string link1;                                      ///< First link (URDF link1 / the guide of a slider).
-  std::string link2;                                      ///< Second link.
+  std::string link1;  ///< First link (URDF link1 / the guide of a slider).
+  std::string link2;  ///< Second link.
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();  ///< Joint frame in world [m].
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();        ///< Motion axis (first universal axis, on link1), world unit vector.
-  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitX();       ///< Universal only: second axis (on link2), world unit vector.
-  Eigen::Vector3d point2 = Eigen::Vector3d::Zero();       ///< Distance only: end on link2 (end on link1 is frame origin) [m].
+  Eigen::Vector3d axis =
+      Eigen::Vector3d::UnitZ();  ///< Motion axis (first universal axis, on link1), world unit vector.
+  Eigen::Vector3d axis2 =
+      Eigen::Vector3d::UnitX();  ///< Universal only: second axis (on link2), world unit vector.
+  Eigen::Vector3d point2 =
+      Eigen::Vector3d::Zero();  ///< Distance only: end on link2 (end on link1 is frame origin) [m].
 };
 
 /// A rigid link of the description: a name and what to draw.
 struct LinkDescription {
-  std::string name;                         ///< Unique among links; the first link is the ground.
-  std::vector<Eigen::Vector3d> visualPath;  ///< World points [m] joined by cylinders; empty: star over its joint points.
-  std::optional<Eigen::Isometry3d> floatingFrame;  ///< World frame used if the link hangs by a `floating` joint.
+  std::string name;  ///< Unique among links; the first link is the ground.
+  std::vector<Eigen::Vector3d>
+      visualPath;  ///< World points [m] joined by cylinders; empty: star over its joint points.
+  std::optional<Eigen::Isometry3d>
+      floatingFrame;  ///< World frame used if the link hangs by a `floating` joint.
 };
 
 /**
@@ -62,21 +76,21 @@ struct LinkDescription {
  * redundant = dof − grubler (DESIGN.md §3).
  */
 struct FamilyExpectation {
-  std::string mode;  ///< "planar" or "spatial".
-  int lambda = 6;    ///< 3 (planar) or 6 (spatial).
-  int dof = 0;       ///< True degrees of freedom (nullity of the constraint Jacobian).
-  int grubler = 0;   ///< Grübler–Kutzbach count for this lambda.
-  int redundant = 0; ///< Number of redundant equations = dof − grubler.
+  std::string mode;   ///< "planar" or "spatial".
+  int lambda = 6;     ///< 3 (planar) or 6 (spatial).
+  int dof = 0;        ///< True degrees of freedom (nullity of the constraint Jacobian).
+  int grubler = 0;    ///< Grübler–Kutzbach count for this lambda.
+  int redundant = 0;  ///< Number of redundant equations = dof − grubler.
 };
 
 /// A mechanism at one configuration: links, connections and what the analysis should report.
 struct MechanismDescription {
-  std::string name;                              ///< URDF robot name.
-  std::string comment;                           ///< Where the numbers come from; written as an XML comment.
-  std::vector<LinkDescription> links;            ///< links.front() is the ground (URDF root).
-  std::vector<Connection> connections;           ///< In document order; the order decides the spanning tree.
-  std::vector<FamilyExpectation> expectations;   ///< One per mode the model is meant to be analysed in.
-  double visualRadius = 0.01;                    ///< Radius of the drawn cylinders [m].
+  std::string name;                             ///< URDF robot name.
+  std::string comment;                          ///< Where the numbers come from; written as an XML comment.
+  std::vector<LinkDescription> links;           ///< links.front() is the ground (URDF root).
+  std::vector<Connection> connections;          ///< In document order; the order decides the spanning tree.
+  std::vector<FamilyExpectation> expectations;  ///< One per mode the model is meant to be analysed in.
+  double visualRadius = 0.01;                   ///< Radius of the drawn cylinders [m].
 };
 
 /// Why a description or a command line could not be turned into a URDF.
@@ -102,19 +116,21 @@ Connection makeRevolute(std::string name, std::string link1, std::string link2, 
                         const Eigen::Vector3d& axis);
 
 /// @return A prismatic connection: link2 slides on link1 along world @p axis through @p origin.
-Connection makePrismatic(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin,
-                         const Eigen::Vector3d& axis);
+Connection makePrismatic(std::string name, std::string link1, std::string link2,
+                         const Eigen::Vector3d& origin, const Eigen::Vector3d& axis);
 
 /// @return A spherical connection centred at @p origin.
-Connection makeSpherical(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin);
+Connection makeSpherical(std::string name, std::string link1, std::string link2,
+                         const Eigen::Vector3d& origin);
 
 /// @return A cylindrical connection along world @p axis through @p origin.
-Connection makeCylindrical(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin,
-                           const Eigen::Vector3d& axis);
+Connection makeCylindrical(std::string name, std::string link1, std::string link2,
+                           const Eigen::Vector3d& origin, const Eigen::Vector3d& axis);
 
 /// @return A universal connection at @p origin, @p axis1 fixed on link1, @p axis2 fixed on link2 (world).
-Connection makeUniversal(std::string name, std::string link1, std::string link2, const Eigen::Vector3d& origin,
-                         const Eigen::Vector3d& axis1, const Eigen::Vector3d& axis2);
+Connection makeUniversal(std::string name, std::string link1, std::string link2,
+                         const Eigen::Vector3d& origin, const Eigen::Vector3d& axis1,
+                         const Eigen::Vector3d& axis2);
 
 /// @return A fixed connection whose frame is @p frame (world).
 Connection makeFixed(std::string name, std::string link1, std::string link2, const Eigen::Isometry3d& frame);

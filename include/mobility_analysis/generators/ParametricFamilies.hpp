@@ -17,8 +17,8 @@ std::vector<FamilyExpectation> expectSlePlanarMast(int units);
 
 /**
  * @brief Planar scissor (SLE) mast in the x–y plane: N units of two crossing bars (length 1 m, 50° to the
- *        horizontal, pivoted at their midpoints), bar 1a pinned to the ground, bar 1b's foot pinned to a slider
- *        block that slides along x on the ground.
+ *        horizontal, pivoted at their midpoints), bar 1a pinned to the ground, bar 1b's foot pinned to a
+ * slider block that slides along x on the ground.
  * @param[in] units N ≥ 1.
  * @note Expectations: see expectSlePlanarMast().
  */
@@ -27,21 +27,25 @@ MechanismDescription makeSlePlanarMast(int units);
 /**
  * @brief Closed-form expectations of the triangular scissor mast (makeSleSpatialMast()).
  *
- * Links 6N (6 bars per unit, one of them the ground), joints 12N − 3: 3N centre revolutes, 6(N − 1) face
- * pins (revolute) and 3(N + 1) corner spherical joints; Σ F = 18N + 3.
- * spatial (λ 6): DOF 1, Grübler 6(6N − (12N − 3) − 1) + 18N + 3 = 15 − 18N, redundant 18N − 14.
+ * Links 6N (6 bars per unit, one of them the ground), joints 12N − 3: 3N centre revolutes and 9N − 3
+ * spherical joints (6(N − 1) face pins, 3(N + 1) corner joints); Σ F = 30N − 9.
+ * spatial (λ 6): DOF 1, Grübler 6(6N − (12N − 3) − 1) + 30N − 9 = 3 − 6N, redundant 6N − 2.
  */
 std::vector<FamilyExpectation> expectSleSpatialMast(int units);
 
 /**
- * @brief Spatial scissor mast: a right prism on an equilateral triangle whose three faces are planar scissor
- *        chains (bars 1 m at 50° to the horizontal, centre pivots normal to the face); at every node level the
- *        two faces meeting at a corner are joined by a spherical joint, and bar `bar_1_0_a` is the ground.
+ * @brief Spatial scissor mast: a right prism on an equilateral triangle whose three faces are scissor chains
+ *        (bars 1 m at 50° to the horizontal, centre revolutes about the face normal); all other joints are
+ *        spherical: face pins between consecutive units and, at every level, corner joints between the two
+ *        faces meeting there. Bar `bar_1_0_a` is the ground; bars held only by spherical joints hang by
+ *        `floating` joints.
  *
- * Why DOF 1: each face is a planar chain of identical units, so its nodes lie on two parallel edges, equally
- * spaced; shared corner nodes force equal unit heights, hence equal widths w on all faces; three faces
- * sharing their edges pairwise make a right prism on an equilateral triangle of side w, and w (with
- * h² + w² = 1) is the only parameter. Per unit 6 links and 12 joints (≈ 54 joint equations).
+ * Why DOF 1: each unit's four ends form a rectangle with diagonal 1 m; a face's rectangles share horizontal
+ * edges (one width per face), shared vertical edges force equal heights, so every level is an equilateral
+ * triangle of side w, and since opposite rectangle sides are parallel and equal each level is the previous
+ * one translated by h along its normal: a right prism with w² + h² = 1 as the only parameter. Per unit 6
+ * links and 12 joints (3 R + 9 S, 42 joint equations); verified numerically (Jacobian nullity 1, finite
+ * motion).
  * @param[in] units N ≥ 1.
  * @note Expectations: see expectSleSpatialMast().
  */

@@ -7,7 +7,8 @@
 namespace mobility_analysis {
 
 /**
- * @brief Grashof crank-rocker: ground 1.0, crank 0.35, coupler 1.1, rocker 0.8 [m] (s + l = 1.45 < p + q = 1.8).
+ * @brief Grashof crank-rocker: ground 1.0, crank 0.35, coupler 1.1, rocker 0.8 [m] (s + l = 1.45 < p + q
+ * = 1.8).
  *
  * Expected: planar (λ 3) DOF 1, Grübler 1, redundant 0; spatial (λ 6) DOF 1, Grübler −2, redundant 3.
  * @param[in] crankAngle Crank angle from the ground line [rad]; the rocker closes the open branch.
