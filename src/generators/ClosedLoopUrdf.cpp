@@ -376,7 +376,8 @@ void writeLayout(const MechanismDescription& mechanism, const ClosedLoopLayout& 
         appendNumber(chunk, cylinder.radius);
         chunk += "\" length=\"";
         appendNumber(chunk, cylinder.length);
-        chunk += "\"/></geometry></visual>\n";
+        // A neutral material: rviz draws a visual without one in red, the colour of a redundant element.
+        chunk += "\"/></geometry><material name=\"neutral_grey\"><color rgba=\"0.7 0.7 0.72 1\"/></material></visual>\n";
       }
       chunk += "  </link>\n";
     }
