@@ -45,7 +45,7 @@ struct Direction {
 /// The algebraic form of one scalar equation f(q) = 0.
 enum class EquationForm {
   Dot,          ///< a·b - value
-  Cross,        ///< (a x b)_component; planar: a_x b_y - a_y b_x
+  Cross,        ///< (a x b)_component - value; planar: a_x b_y - a_y b_x - value
   Component,    ///< a_component - value
   Combination,  ///< (x_target - x_origin - c0 d1 - c1 d2 - c2 d1 x d2)_component; planar: d2 := J d1, no c2 term
 };
@@ -80,7 +80,7 @@ struct ConstraintEquation {
   int origin = -1;            ///< Combination: the body's base point (points only), else -1.
   Direction d1, d2;           ///< Combination: the body's basis directions (planar: d2 unused).
   Eigen::Vector3d coefficients = Eigen::Vector3d::Zero();  ///< Combination: c0, c1, c2.
-  double value = 0.0;         ///< Dot, Component: the constant.
+  double value = 0.0;         ///< Dot, Cross, Component: the constant.
   std::string text;           ///< Readable form, e.g. "|P(crank@j2) - P(crank@j1)|^2 = 1".
 };
 

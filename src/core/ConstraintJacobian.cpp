@@ -32,7 +32,7 @@ class EquationEvaluator {
     const int k = eq.component;
     switch (eq.form) {
       case EquationForm::Dot: return direction(eq.a).dot(direction(eq.b)) - eq.value;
-      case EquationForm::Cross: return direction(eq.a).cross(direction(eq.b))[dim_ == 3 ? k : 2];
+      case EquationForm::Cross: return direction(eq.a).cross(direction(eq.b))[dim_ == 3 ? k : 2] - eq.value;
       case EquationForm::Component: return direction(eq.a)[k] - eq.value;
       case EquationForm::Combination: {
         const Eigen::Vector3d d1 = direction(eq.d1);

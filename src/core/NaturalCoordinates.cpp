@@ -498,22 +498,45 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
           auto worldOf = [&](const Direction& d) {
             return d.tail < 0 ? builder.world[d.head] : (builder.world[d.head] - builder.world[d.tail]).eval();
           };
+          // Two candidate forms per pair: a.b (rate n.(b x a)) and (a x b)_k (rate (n (a.b) - b (a.n))_k), so a
+          // pair of directions parallel to each other (two axes along the same normal) still sees the turn.
           double best = -1.0;
           ConstraintEquation eq = base(EquationKind::FixedTwist, EquationForm::Dot);
           for (const Direction& da : dirsA) {
             for (const Direction& db : dirsB) {
               const Eigen::Vector3d va = directionValue(da);
               const Eigen::Vector3d vb = project(aligned * worldOf(db));
-              const double sensitivity = std::abs(n.dot(vb.cross(va))) / (va.norm() * vb.norm());
-              if (sensitivity > best) {
-                best = sensitivity;
+              const double scale = va.norm() * vb.norm();
+              const double dotRate = std::abs(n.dot(vb.cross(va))) / scale;
+              if (dotRate > best * (1.0 + 1e-9)) {
+                best = dotRate;
+                eq.form = EquationForm::Dot;
                 eq.a = da;
                 eq.b = db;
                 eq.value = va.dot(vb);
               }
+              // In space a cross component is invariant under a rigid motion of the whole mechanism only where
+              // a x b = 0, so that form is used for parallel pairs alone (in the plane it always is).
+              const bool parallel = va.cross(vb).norm() <= 1e-9 * scale;
+              const Eigen::Vector3d crossRate = (n * va.dot(vb) - vb * va.dot(n)) / scale;
+              for (int k = planar ? 2 : 0; k < 3 && (planar || parallel); ++k) {
+                const double rate = planar ? std::abs(va.dot(vb)) / scale : std::abs(crossRate[k]);
+                if (rate > best * (1.0 + 1e-9)) {
+                  best = rate;
+                  eq.form = EquationForm::Cross;
+                  eq.component = k;
+                  eq.a = da;
+                  eq.b = db;
+                  eq.value = planar ? va.cross(vb)[k] : 0.0;
+                }
+              }
             }
           }
-          eq.text = directionName(eq.a) + "." + directionName(eq.b) + " = " + format(eq.value);
+          eq.text = eq.form == EquationForm::Dot
+                        ? directionName(eq.a) + "." + directionName(eq.b) + " = " + format(eq.value)
+                        : "(" + directionName(eq.a) + " x " + directionName(eq.b) + ")" +
+                              (planar ? std::string("") : std::string("_") + kAxisNames[eq.component]) + " = " +
+                              format(eq.value);
           addEquation(eq);
           break;
         }
