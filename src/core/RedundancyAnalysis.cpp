@@ -82,17 +82,23 @@ std::vector<int> traceDependency(int row, const std::vector<std::pair<int, doubl
   return support;
 }
 
+/// An answer for m equations in n coordinates with nothing decided yet.
+OrderedRank makeEmptyOrderedRank(int m, int n, double tolerance) {
+  OrderedRank result;
+  result.numCoordinates = n;
+  result.tolerance = tolerance;
+  result.redundant.assign(m, false);
+  result.nullityTrace.resize(m);
+  return result;
+}
+
 }  // namespace
 
 OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies,
                                const Eigen::VectorXd* rowScale) {
   const int m = static_cast<int>(J.rows());
   const int n = static_cast<int>(J.cols());
-  OrderedRank result;
-  result.numCoordinates = n;
-  result.tolerance = tolerance;
-  result.redundant.assign(m, false);
-  result.nullityTrace.resize(m);
+  OrderedRank result = makeEmptyOrderedRank(m, n, tolerance);
   std::vector<PivotRow> pivots;
   std::vector<int> pivotOfColumn(n, -1);
   SparseAccumulator row(n);
@@ -189,11 +195,7 @@ OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool c
 OrderedRank computeOrderedRankDense(const Eigen::MatrixXd& J, double tolerance) {
   const int m = static_cast<int>(J.rows());
   const int n = static_cast<int>(J.cols());
-  OrderedRank result;
-  result.numCoordinates = n;
-  result.tolerance = tolerance;
-  result.redundant.assign(m, false);
-  result.nullityTrace.resize(m);
+  OrderedRank result = makeEmptyOrderedRank(m, n, tolerance);
   // Orthonormal basis Q of the rows kept so far, and T with q_k = sum_i T(k, i) J_i / |J_i|.
   Eigen::MatrixXd Q(n, 0);
   Eigen::MatrixXd T(0, m);
