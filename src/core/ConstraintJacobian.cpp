@@ -49,7 +49,7 @@ class EquationEvaluator {
   /// Appends (row, column, value) of the equation's gradient; repeated columns are summed by setFromTriplets.
   void gradient(const ConstraintEquation& eq, int row, std::vector<Eigen::Triplet<double>>& triplets) const {
     const int k = eq.component;
-    const Eigen::Vector3d ek = Eigen::Vector3d::Unit(dim_ == 3 ? k : k);
+    const Eigen::Vector3d ek = Eigen::Vector3d::Unit(k);
     switch (eq.form) {
       case EquationForm::Dot: {
         // d(a.b) = b.da + a.db

@@ -577,7 +577,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
   {
     const int root = mechanism.rootLink;
     const BodyBasis& basis = bases[root];
-    const std::string& name = mechanism.links[root].name;
     auto fix = [&](int element, int k) {
       ConstraintEquation eq;
       eq.source = EquationSource::Boundary;
@@ -599,7 +598,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     if (planar) {
       const Eigen::Vector3d d1 = directionValue(basis.d1);
       fix(basis.d1.head, std::abs(d1.y()) >= std::abs(d1.x()) ? 0 : 1);
-      (void)name;
     } else {
       std::vector<std::pair<int, int>> rows;
       std::vector<Eigen::Vector3d> gradients;

@@ -107,6 +107,7 @@ OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool c
   std::priority_queue<int, std::vector<int>, std::greater<int>> pending;  // pivot indices, oldest first
   std::vector<bool> queued;
   std::vector<std::pair<int, double>> multipliers;
+  std::vector<int> visited;
 
   for (int r = 0; r < m; ++r) {
     // Each equation scaled to unit norm, so the threshold is relative to the equation itself.
@@ -127,7 +128,7 @@ OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool c
     }
     // Reduce by the pivot rows in the order they were made: P_k is zero at the pivot columns of earlier pivots,
     // so fill only ever reaches later ones.
-    std::vector<int> visited;
+    visited.clear();
     while (!pending.empty()) {
       const int k = pending.top();
       pending.pop();
