@@ -15,11 +15,8 @@ namespace mobility_analysis {
 /// Options of one analysis.
 struct AnalysisOptions {
   AnalysisMode mode = AnalysisMode::Auto;
-  JointPositions positions;       ///< Starting pose; empty: the URDF pose (all tree joints at 0).
-  double rankTolerance = -1.0;    ///< Relative rank threshold; <= 0: tolerances::kRank.
-  /// Links with more than this many equations in all skip the redundant-link search (each candidate costs one
-  /// elimination); the report then says redundant_links_computed: false.
-  int redundantLinkSearchLimit = 200000;
+  JointPositions positions;     ///< Starting pose; empty: the URDF pose (all tree joints at 0).
+  double rankTolerance = -1.0;  ///< Relative rank threshold; <= 0: tolerances::kRank.
   /// Called with a phase name and a fraction in [0, 1] during long analyses; may be empty.
   std::function<void(const std::string&, double)> progress;
 };

@@ -1,46 +1,73 @@
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "mobility_analysis/ConstraintJacobian.hpp"
+#include "mobility_analysis/SparseElimination.hpp"
 
 namespace mobility_analysis {
 
 /**
- * @brief The lecture's ordered rank test: for each equation, whether it depends on the equations before it.
+ * @brief The ordered rank test: for each equation, whether it depends on the equations taken before it.
  */
 struct OrderedRank {
   int rank = 0;
   int numCoordinates = 0;
-  std::vector<bool> redundant;   ///< Per equation.
-  std::vector<int> nullityTrace; ///< Nullity after equations 0..k (dim num_constraints).
-  /// For each redundant equation (in order): the equations of its dependency (the support of the left null
-  /// vector y with y_r = 1 that combines only r and independent equations before it), r included.
-  std::vector<std::vector<int>> dependencies;
-  double smallestKeptPivot = 0.0;      ///< Smallest relative pivot of an independent equation [-].
-  double largestDroppedResidual = 0.0; ///< Largest relative residual of a redundant equation [-].
-  double tolerance = 0.0;              ///< Threshold used [-].
+  std::vector<bool> redundant;    ///< Per equation (indexed by row).
+  std::vector<int> nullityTrace;  ///< Nullity after each equation taken, in the order taken (dim rows taken).
+  /// For each redundant equation r (in the order found): the self-stress with y_r = 1 that combines only r
+  /// and independent equations taken before it.
+  std::vector<SelfStress> dependencies;
+  double smallestKeptPivot = 0.0;       ///< Smallest relative pivot of an independent equation [-].
+  double largestDroppedResidual = 0.0;  ///< Largest relative residual of a redundant equation [-].
+  double tolerance = 0.0;               ///< Threshold used [-].
   int dof() const { return numCoordinates - rank; }
 };
 
-/**
- * @brief Ordered rank by sparse incremental elimination (threshold partial pivoting over coordinates only).
- *
- * Equations are taken in row order and never reordered; each row, scaled to unit norm, is reduced by the
- * pivot rows before it. If what remains is below @p tolerance the equation is redundant (its nullity step is
- * 0), otherwise it becomes a pivot row. Cost is proportional to the fill, not to the cube of the size.
- * @param[in] J row-major Jacobian, rows in contract order.
- * @param[in] tolerance relative threshold (tolerances::kRank by default).
- * @param[in] computeDependencies whether to compute each redundant equation's dependency.
- */
-/// @param[in] rowScale when given, row r is scaled by rowScale(r) instead of by 1 / its norm (dim J.rows()).
-OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies = true,
-                               const Eigen::VectorXd* rowScale = nullptr);
+/// How computeSparseElimination takes the rows and picks its pivots.
+struct EliminationOptions {
+  /// Rows in the order they are taken; empty: 0, 1, …, m − 1. Rows left out are not taken.
+  std::vector<int> rowOrder;
+  /// Pivot preference of each column, lower first (dim n); empty: the column index.
+  std::vector<int> columnPriority;
+  /// Row r is scaled by rowScale(r) instead of 1 / |J_r| when given (dim m).
+  Eigen::VectorXd rowScale;
+  /// Whether to compute each redundant row's dependency (SelfStress).
+  bool computeDependencies = false;
+  /// Once every column holds a pivot, the remaining rows are dependent: mark them without reducing them
+  /// (their dependencies are then not computed).
+  bool stopAtFullRank = false;
+};
 
 /**
- * @brief Reference implementation: dense, with a rank-revealing QR of the Gram-Schmidt residual of each row.
+ * @brief The ordered rank test of the rows of @p J taken in @p options.rowOrder, by one SparseElimination.
+ *
+ * Each row is scaled to unit norm (or by options.rowScale), so the threshold is relative to the equation
+ * itself.
+ * @param[in] J row-major matrix.
+ * @param[in] tolerance relative threshold (tolerances::kRank by default).
+ * @param[in] options row order, column priorities, scaling.
+ */
+OrderedRank computeSparseElimination(const SparseJacobian& J, double tolerance,
+                                     const EliminationOptions& options);
+
+/**
+ * @brief The lecture's ordered rank test in contract order, by computeSparseElimination over the rows as
+ * given.
+ *
+ * Exact for any model but quadratic on long chains of loops (a loop row reduced by the tree rows before it
+ * spans its whole tree path); the report uses computeOrderedRedundancy, and this is its reference.
+ * @param[in] J row-major Jacobian, rows in contract order.
+ * @param[in] tolerance relative threshold.
+ * @param[in] computeDependencies whether to compute each redundant equation's dependency.
+ */
+OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies = true);
+
+/**
+ * @brief Reference implementation: dense, with Gram–Schmidt of each row against the rows kept before it.
  *
  * Same contract as computeOrderedRank (dependencies included); O(m n^2). For tests and benchmarks.
  */
@@ -48,7 +75,8 @@ OrderedRank computeOrderedRankDense(const Eigen::MatrixXd& J, double tolerance);
 
 /**
  * @brief The lecture's literal algorithm: after each equation, the nullity of the rows so far by a
- *        rank-revealing decomposition (ColPivHouseholderQR with an explicit threshold). O(m^2 n^2); for benchmarks.
+ *        rank-revealing decomposition (ColPivHouseholderQR with an explicit threshold). O(m^2 n^2); for
+ * benchmarks.
  */
 std::vector<int> computeNullityTraceLiteral(const Eigen::MatrixXd& J, double tolerance);
 

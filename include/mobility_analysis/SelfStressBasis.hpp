@@ -1,0 +1,74 @@
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "mobility_analysis/ConstraintJacobian.hpp"
+#include "mobility_analysis/EliminationOrder.hpp"
+#include "mobility_analysis/Mechanism.hpp"
+#include "mobility_analysis/NaturalCoordinates.hpp"
+#include "mobility_analysis/RedundancyAnalysis.hpp"
+#include "mobility_analysis/SparseElimination.hpp"
+
+namespace mobility_analysis {
+
+/**
+ * @brief A basis of the left null space of the constraint Jacobian: its self-stresses.
+ *
+ * Every redundancy of a mechanism is one self-stress, \f$ y^T \Phi_q = 0 \f$ (constraint forces in
+ * equilibrium with nothing applied), so num_constraints − rank of them span the space. A sparse basis is
+ * found once, by an elimination in an order where it stays local (computeSweepOrder), and every ordered
+ * question is then answered from it.
+ */
+struct SelfStressBasis {
+  /// The basis; stress k is the one the sweep revealed at its last equation, with coefficient 1 there.
+  std::vector<SelfStress> stresses;
+  int numConstraints = 0;
+  int numCoordinates = 0;
+  int rank = 0;                         ///< Rank of the Jacobian.
+  double smallestKeptPivot = 0.0;       ///< Of the sweep's elimination (see OrderedRank) [-].
+  double largestDroppedResidual = 0.0;  ///< Likewise [-].
+  int locallyResolved = 0;              ///< Stresses found by a local elimination around their equation.
+};
+
+/// Progress of a long computation: a fraction in [0, 1]; may be empty.
+using ProgressCallback = std::function<void(double)>;
+
+/**
+ * @brief Finds a sparse basis of the self-stresses by one elimination of @p J in sweep order.
+ *
+ * Each equation the sweep finds dependent on those before it reveals one stress: the unique one over that
+ * equation and independent equations before it. That one is local when the loop the equation closes is short,
+ * but where loops share a closing connection it runs back along the whole chain of loops; such a stress is
+ * replaced by one found by the same elimination restricted to the links around the equation (a ball of
+ * growing radius), which is as local as the mechanism's own loops and has the same last equation, so the
+ * basis stays a basis.
+ * @param[in] mechanism the mechanism.
+ * @param[in] model its natural-coordinate model.
+ * @param[in] J the constraint Jacobian at the assembled pose (rows in contract order; the basis uses these
+ * rows).
+ * @param[in] tolerance relative rank threshold.
+ * @param[in] progress called with the fraction of equations swept.
+ */
+SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
+                                       const SparseJacobian& J, double tolerance,
+                                       const ProgressCallback& progress = {});
+
+/**
+ * @brief The lecture's ordered rank test read off a self-stress basis, without eliminating in contract order.
+ *
+ * Equation r depends on the equations before it exactly when some self-stress has r as its last equation
+ * (\f$ J_r = -\sum_{i<r} y_i J_i / y_r \f$). So the redundant equations are the pivots of the basis reduced
+ * to echelon form on each vector's last equation: the rows of the basis matrix Y taken from the last equation
+ * up, each one kept when it is independent of the rows after it. Y has one column per redundancy and is as
+ * local as the stresses, so this costs little next to finding the basis.
+ * @param[in] basis the self-stresses of the Jacobian (any basis gives the same answer).
+ * @param[in] tolerance threshold for a row of Y (stresses scaled to unit largest coefficient) to be
+ * independent of the rows after it.
+ * @return The ordered rank in contract order (no dependencies), or nothing when the reduction found fewer
+ *         pivots than the basis has stresses (a numerically ambiguous basis: use computeOrderedRank).
+ */
+std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis& basis, double tolerance);
+
+}  // namespace mobility_analysis

@@ -1,0 +1,103 @@
+#pragma once
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "mobility_analysis/ConstraintJacobian.hpp"
+
+namespace mobility_analysis {
+
+/**
+ * @brief A left null vector y of the constraint Jacobian (\f$ y^T \Phi_q = 0 \f$): a self-stress.
+ *
+ * Sparse, as (equation, coefficient) pairs by increasing equation. Coefficients refer to the rows scaled to
+ * unit norm (the scaling every elimination here works in).
+ */
+using SelfStress = std::vector<std::pair<int, double>>;
+
+/// @return The equations of @p stress (its support), increasing.
+std::vector<int> supportOf(const SelfStress& stress);
+
+/**
+ * @brief Incremental sparse elimination with threshold partial pivoting over columns only.
+ *
+ * Rows are added one at a time and never reordered; each row, scaled, is reduced by the pivot rows made
+ * before it. If what remains is below the tolerance the row is dependent on the rows added before it,
+ * otherwise it becomes a pivot row at the column of lowest priority among its entries within
+ * tolerances::kPivotThreshold of its largest. Pivot rows are pooled (immutable once made), and with their
+ * multipliers kept each dependent row's dependency can be traced back to the rows it combines. Cost is
+ * proportional to the fill, which stays small when the rows and the column priorities sweep the structure in
+ * the same direction.
+ */
+class SparseElimination {
+ public:
+  /**
+   * @param[in] numColumns n.
+   * @param[in] columnPriority pivot preference of each column, lower first (dim n); empty: the column index.
+   * @param[in] tolerance relative threshold: a row whose reduced norm is at most this is dependent [-].
+   * @param[in] keepMultipliers whether to keep what traceDependency needs.
+   */
+  SparseElimination(int numColumns, std::vector<int> columnPriority, double tolerance, bool keepMultipliers);
+
+  /// What adding one row found.
+  struct Step {
+    bool dependent = false;
+    double residual = 0.0;  ///< Norm of the reduced row (the row scaled as given) [-].
+  };
+
+  /**
+   * @brief Reduces row @p r of @p J, multiplied by @p scale, and keeps it as a pivot row when it is
+   * independent.
+   *
+   * Afterwards multipliers() holds the reduction, J_r scale = sum_k m_k P_k + residual.
+   */
+  Step addRow(const SparseJacobian& J, int r, double scale);
+
+  /// Multipliers (pivot k, m_k) of the last row added.
+  const std::vector<std::pair<int, double>>& multipliers() const { return multipliers_; }
+
+  /**
+   * @brief The dependency of a dependent row: y with y_row = 1 over @p row and the independent rows it
+   * combines.
+   * @param[in] row the dependent row.
+   * @param[in] multipliers its reduction (multipliers() right after it was added).
+   * @param[in] maxSupport give up (return nothing) once the dependency has more equations than this; 0: no
+   * limit.
+   */
+  std::optional<SelfStress> traceDependency(int row, const std::vector<std::pair<int, double>>& multipliers,
+                                            size_t maxSupport = 0);
+
+  int rank() const { return static_cast<int>(origin_.size()); }
+  int numColumns() const { return static_cast<int>(pivotOfColumn_.size()); }
+  double smallestKeptPivot() const;  ///< 0 when no row was kept.
+  double largestDroppedResidual() const { return largestDropped_; }
+
+ private:
+  int priority(int column) const { return columnPriority_.empty() ? column : columnPriority_[column]; }
+
+  std::vector<int> columnPriority_;
+  double tolerance_;
+  bool keepMultipliers_;
+
+  // Pivot rows P_k = scale J_origin(k) - sum_j m_kj P_j, pooled: entries of P_k are
+  // entries_[entryStart_[k] .. entryStart_[k+1]), its multipliers likewise.
+  std::vector<int> origin_, column_;
+  std::vector<double> pivot_;
+  std::vector<size_t> entryStart_ = {0}, multiplierStart_ = {0};
+  std::vector<std::pair<int, double>> entries_, pivotMultipliers_;
+  std::vector<int> pivotOfColumn_;
+
+  // Workspace, reused across rows.
+  std::vector<double> values_;
+  std::vector<char> present_, queued_;
+  std::vector<int> touched_, visited_;
+  std::vector<std::pair<int, double>> multipliers_;
+  std::vector<double> coefficient_;
+  std::vector<char> traced_;
+
+  double smallestKept_ = -1.0;
+  double largestDropped_ = 0.0;
+};
+
+}  // namespace mobility_analysis

@@ -1,0 +1,111 @@
+#include "mobility_analysis/EliminationOrder.hpp"
+
+#include <algorithm>
+#include <deque>
+
+namespace mobility_analysis {
+
+EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateModel& model) {
+  const int numLinks = static_cast<int>(mechanism.links.size());
+  const int numJoints = static_cast<int>(mechanism.joints.size());
+
+  // Equations grouped by what releases them: rigid-link and boundary rows by their link, joint rows by their
+  // joint.
+  std::vector<std::vector<int>> linkRows(numLinks), boundaryRows(numLinks), jointRows(numJoints);
+  for (int r = 0; r < model.numConstraints(); ++r) {
+    const ConstraintEquation& eq = model.equations[r];
+    switch (eq.source) {
+      case EquationSource::Link:
+        linkRows[eq.element].push_back(r);
+        break;
+      case EquationSource::Boundary:
+        boundaryRows[eq.element].push_back(r);
+        break;
+      case EquationSource::Joint:
+        jointRows[eq.element].push_back(r);
+        break;
+    }
+  }
+  // Only connections with equations couple their links: a floating joint (a link held by loop joints alone)
+  // or a slack cable would let the sweep jump from the ground straight into the middle of the mechanism.
+  std::vector<std::vector<int>> incident(numLinks);
+  auto otherEnd = [&](int joint, int link) {
+    return mechanism.joints[joint].link1 == link ? mechanism.joints[joint].link2
+                                                 : mechanism.joints[joint].link1;
+  };
+  for (int j = 0; j < numJoints; ++j) {
+    const Joint& joint = mechanism.joints[j];
+    if (jointRows[j].empty() || joint.link1 == joint.link2)
+      continue;
+    incident[joint.link1].push_back(j);
+    incident[joint.link2].push_back(j);
+  }
+
+  // Breadth-first discovery from the ground (then any other component, so every equation is placed).
+  std::vector<int> discovered(numLinks, -1), sweep;
+  sweep.reserve(numLinks);
+  std::deque<int> queue;
+  std::vector<int> starts = {mechanism.rootLink};
+  for (int l = 0; l < numLinks; ++l)
+    starts.push_back(l);
+  for (int start : starts) {
+    if (discovered[start] >= 0)
+      continue;
+    discovered[start] = static_cast<int>(sweep.size());
+    sweep.push_back(start);
+    queue.push_back(start);
+    while (!queue.empty()) {
+      const int link = queue.front();
+      queue.pop_front();
+      for (int j : incident[link]) {
+        const int other = otherEnd(j, link);
+        if (discovered[other] < 0) {
+          discovered[other] = static_cast<int>(sweep.size());
+          sweep.push_back(other);
+          queue.push_back(other);
+        }
+      }
+    }
+  }
+
+  // Each link attaches to the most recently discovered of its earlier neighbours, and its other connections
+  // to earlier links close loops. Why the most recent: the redundant equations an elimination reveals are
+  // those of the connection that closes a loop, and its self-stress is the unique one over that connection
+  // and independent equations before it. When each closing connection closes a short loop of the attaching
+  // ones (a ladder's rungs and one rail attach, the other rail closes squares; breadth-first parents alone
+  // would run both rails down to the ground), no closing connection lies in another's loop and every stress
+  // stays as local as the mechanism's own loops.
+  EliminationOrder order;
+  order.rows.reserve(model.numConstraints());
+  order.columnPriority.assign(model.numCoordinates(), 0);
+  int nextColumn = 0;
+  std::vector<int> closing;
+  for (int link : sweep) {
+    for (int e : model.bodyElements[link]) {
+      for (int i = 0; i < model.dim; ++i)
+        order.columnPriority[model.elements[e].offset + i] = nextColumn++;
+    }
+    order.rows.insert(order.rows.end(), linkRows[link].begin(), linkRows[link].end());
+    order.rows.insert(order.rows.end(), boundaryRows[link].begin(), boundaryRows[link].end());
+    closing.clear();
+    int attaching = -1;
+    for (int j : incident[link]) {
+      const int other = otherEnd(j, link);
+      if (discovered[other] >= discovered[link])
+        continue;
+      closing.push_back(j);
+      if (attaching < 0 || discovered[other] > discovered[otherEnd(attaching, link)])
+        attaching = j;
+    }
+    std::stable_sort(closing.begin(), closing.end(), [&](int a, int b) {
+      if ((a == attaching) != (b == attaching))
+        return a == attaching;
+      return discovered[otherEnd(a, link)] > discovered[otherEnd(b, link)];
+    });
+    for (int j : closing)
+      order.rows.insert(order.rows.end(), jointRows[j].begin(), jointRows[j].end());
+  }
+  return order;
+}
+
+}  // namespace mobility_analysis

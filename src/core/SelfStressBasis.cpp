@@ -1,0 +1,315 @@
+#include "mobility_analysis/SelfStressBasis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace mobility_analysis {
+
+namespace {
+
+/// A traced stress with more equations than this is probably running down a chain of loops (a loop of four
+/// spatial links has about 70); it is found again by a local elimination instead [equations].
+constexpr size_t kTraceLimit = 160;
+
+/// The local elimination gives up on balls with more equations than this; the stress is then traced in full,
+/// as it really is global (a ring's) [equations].
+constexpr size_t kLocalLimit = 6000;
+
+/// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
+constexpr double kStressNoise = 1e-10;
+
+/// Which equations belong to which link and connection, and which connections couple which links.
+struct EquationGraph {
+  std::vector<std::vector<int>> linkRows;   ///< Rigid-link and boundary rows of each link.
+  std::vector<std::vector<int>> jointRows;  ///< Rows of each connection.
+  std::vector<std::vector<int>> incident;   ///< Connections with equations at each link.
+
+  EquationGraph(const Mechanism& mechanism, const CoordinateModel& model)
+      : linkRows(mechanism.links.size()),
+        jointRows(mechanism.joints.size()),
+        incident(mechanism.links.size()) {
+    for (int r = 0; r < model.numConstraints(); ++r) {
+      const ConstraintEquation& eq = model.equations[r];
+      (eq.source == EquationSource::Joint ? jointRows : linkRows)[eq.element].push_back(r);
+    }
+    for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+      if (jointRows[j].empty())
+        continue;
+      incident[mechanism.joints[j].link1].push_back(static_cast<int>(j));
+      incident[mechanism.joints[j].link2].push_back(static_cast<int>(j));
+    }
+  }
+};
+
+/**
+ * Finds a stress whose last equation (in sweep order) is a given row among the links within a growing radius
+ * of the row's links: the sweep's elimination restricted to the rows of that ball. Workspaces are kept across
+ * calls, so one call costs what its ball holds, not what the mechanism holds.
+ */
+class LocalStressFinder {
+ public:
+  LocalStressFinder(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J,
+                    const EliminationOrder& order, const std::vector<int>& position, double tolerance)
+      : mechanism_(mechanism),
+        model_(model),
+        J_(J),
+        order_(order),
+        position_(position),
+        tolerance_(tolerance),
+        graph_(mechanism, model),
+        inBall_(mechanism.links.size(), 0),
+        jointTaken_(mechanism.joints.size(), 0),
+        columnMap_(J.cols(), -1) {}
+
+  /// @return The stress, or nothing when the ball grows past kLocalLimit equations first.
+  std::optional<SelfStress> find(int row) {
+    const ConstraintEquation& eq = model_.equations[row];
+    ball_.clear();
+    if (eq.source == EquationSource::Joint) {
+      include(mechanism_.joints[eq.element].link1);
+      include(mechanism_.joints[eq.element].link2);
+    } else {
+      include(eq.element);
+    }
+    std::optional<SelfStress> found;
+    size_t frontBegin = 0;
+    for (int radius = 1, reached = 0; !found; radius *= 2) {
+      for (; reached < radius && frontBegin < ball_.size(); ++reached) {
+        const size_t frontEnd = ball_.size();
+        for (size_t i = frontBegin; i < frontEnd; ++i) {
+          for (int j : graph_.incident[ball_[i]]) {
+            include(mechanism_.joints[j].link1);
+            include(mechanism_.joints[j].link2);
+          }
+        }
+        frontBegin = frontEnd;
+      }
+      const std::vector<int> rows = collectRows(row);
+      if (rows.size() > kLocalLimit)
+        break;
+      found = eliminate(rows);
+      if (frontBegin == ball_.size())
+        break;  // the whole component
+    }
+    for (int link : ball_)
+      inBall_[link] = 0;
+    return found;
+  }
+
+ private:
+  void include(int link) {
+    if (inBall_[link] == 0) {
+      inBall_[link] = 1;
+      ball_.push_back(link);
+    }
+  }
+
+  /// The ball's rows up to @p row, in sweep order.
+  std::vector<int> collectRows(int row) {
+    std::vector<int> rows, joints;
+    for (int link : ball_) {
+      for (int r : graph_.linkRows[link]) {
+        if (position_[r] < position_[row])
+          rows.push_back(r);
+      }
+      for (int j : graph_.incident[link]) {
+        const Joint& joint = mechanism_.joints[j];
+        if (jointTaken_[j] != 0 || inBall_[joint.link1] == 0 || inBall_[joint.link2] == 0)
+          continue;
+        jointTaken_[j] = 1;
+        joints.push_back(j);
+        for (int r : graph_.jointRows[j]) {
+          if (position_[r] <= position_[row])
+            rows.push_back(r);
+        }
+      }
+    }
+    for (int j : joints)
+      jointTaken_[j] = 0;
+    std::sort(rows.begin(), rows.end(), [&](int a, int b) { return position_[a] < position_[b]; });
+    return rows;
+  }
+
+  /// The elimination of @p rows (the last one the row in question): its dependency, if it is dependent.
+  std::optional<SelfStress> eliminate(const std::vector<int>& rows) {
+    std::vector<int> columns;
+    for (int link : ball_) {
+      for (int e : model_.bodyElements[link]) {
+        for (int i = 0; i < model_.dim; ++i)
+          columns.push_back(model_.elements[e].offset + i);
+      }
+    }
+    std::sort(columns.begin(), columns.end(),
+              [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
+    for (size_t c = 0; c < columns.size(); ++c)
+      columnMap_[columns[c]] = static_cast<int>(c);
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (size_t i = 0; i < rows.size(); ++i) {
+      for (SparseJacobian::InnerIterator it(J_, rows[i]); it; ++it) {
+        triplets.emplace_back(static_cast<int>(i), columnMap_[it.col()], it.value());
+      }
+    }
+    for (int c : columns)
+      columnMap_[c] = -1;
+    SparseJacobian local(static_cast<int>(rows.size()), static_cast<int>(columns.size()));
+    local.setFromTriplets(triplets.begin(), triplets.end());
+
+    // Columns are sorted by sweep priority, so the local column index is the priority.
+    SparseElimination elimination(static_cast<int>(columns.size()), {}, tolerance_, true);
+    SparseElimination::Step step;
+    for (int i = 0; i < local.rows(); ++i) {
+      const double norm = local.row(i).norm();
+      step = elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0);
+    }
+    if (!step.dependent)
+      return std::nullopt;
+    SelfStress stress = *elimination.traceDependency(local.rows() - 1, elimination.multipliers());
+    for (auto& entry : stress)
+      entry.first = rows[entry.first];
+    std::sort(stress.begin(), stress.end());
+    return stress;
+  }
+
+  const Mechanism& mechanism_;
+  const CoordinateModel& model_;
+  const SparseJacobian& J_;
+  const EliminationOrder& order_;
+  const std::vector<int>& position_;
+  double tolerance_;
+  EquationGraph graph_;
+  std::vector<int> ball_;
+  std::vector<char> inBall_, jointTaken_;
+  std::vector<int> columnMap_;
+};
+
+}  // namespace
+
+SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
+                                       const SparseJacobian& J, double tolerance,
+                                       const ProgressCallback& progress) {
+  const EliminationOrder order = computeSweepOrder(mechanism, model);
+  const int m = static_cast<int>(J.rows());
+  const int n = static_cast<int>(J.cols());
+  std::vector<int> position(m, 0);
+  for (size_t i = 0; i < order.rows.size(); ++i)
+    position[order.rows[i]] = static_cast<int>(i);
+
+  SelfStressBasis basis;
+  basis.numConstraints = m;
+  basis.numCoordinates = n;
+  SparseElimination elimination(n, order.columnPriority, tolerance, true);
+  std::vector<std::pair<int, std::vector<std::pair<int, double>>>> untraced;  // (row, multipliers)
+  std::vector<int> untracedSlot;
+  const size_t progressStep = std::max<size_t>(1, order.rows.size() / 20);
+  for (size_t i = 0; i < order.rows.size(); ++i) {
+    if (progress && i % progressStep == 0)
+      progress(0.8 * static_cast<double>(i) / static_cast<double>(m));
+    const int r = order.rows[i];
+    const double norm = J.row(r).norm();
+    if (!elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent)
+      continue;
+    std::optional<SelfStress> stress = elimination.traceDependency(r, elimination.multipliers(), kTraceLimit);
+    if (!stress) {
+      untraced.emplace_back(r, elimination.multipliers());
+      untracedSlot.push_back(static_cast<int>(basis.stresses.size()));
+    }
+    basis.stresses.push_back(stress ? std::move(*stress) : SelfStress{});
+  }
+  basis.rank = elimination.rank();
+  basis.smallestKeptPivot = elimination.smallestKeptPivot();
+  basis.largestDroppedResidual = elimination.largestDroppedResidual();
+
+  if (!untraced.empty()) {
+    LocalStressFinder finder(mechanism, model, J, order, position, tolerance);
+    for (size_t k = 0; k < untraced.size(); ++k) {
+      if (progress)
+        progress(0.8 + 0.2 * static_cast<double>(k) / static_cast<double>(untraced.size()));
+      const auto& [row, multipliers] = untraced[k];
+      std::optional<SelfStress> local = finder.find(row);
+      if (local)
+        ++basis.locallyResolved;
+      basis.stresses[untracedSlot[k]] =
+          local ? std::move(*local) : *elimination.traceDependency(row, multipliers);
+    }
+  }
+
+  // Each stress scaled to unit largest coefficient, rounding noise dropped.
+  for (SelfStress& stress : basis.stresses) {
+    double largest = 0.0;
+    for (const auto& entry : stress)
+      largest = std::max(largest, std::abs(entry.second));
+    SelfStress kept;
+    kept.reserve(stress.size());
+    for (const auto& [row, value] : stress) {
+      if (std::abs(value) > kStressNoise * largest)
+        kept.emplace_back(row, value / largest);
+    }
+    stress = std::move(kept);
+  }
+  return basis;
+}
+
+std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis& basis, double tolerance) {
+  const int m = basis.numConstraints;
+  const int n = basis.numCoordinates;
+  const int numStresses = static_cast<int>(basis.stresses.size());
+  OrderedRank result;
+  result.numCoordinates = n;
+  result.tolerance = tolerance;
+  result.rank = basis.rank;
+  result.redundant.assign(m, false);
+  result.smallestKeptPivot = basis.smallestKeptPivot;
+  result.largestDroppedResidual = basis.largestDroppedResidual;
+
+  if (numStresses > 0) {
+    // Y, one column per stress.
+    std::vector<Eigen::Triplet<double>> triplets;
+    std::vector<int> leaves(numStresses, m);  // the stress's first row: where the upward sweep leaves it
+    for (int s = 0; s < numStresses; ++s) {
+      for (const auto& [row, value] : basis.stresses[s]) {
+        triplets.emplace_back(row, s, value);
+        leaves[s] = std::min(leaves[s], row);
+      }
+    }
+    SparseJacobian Y(m, numStresses);
+    Y.setFromTriplets(triplets.begin(), triplets.end());
+
+    // Rows from the last equation up, unscaled (the stresses are scaled instead, so a row of rounding noise
+    // stays noise); the stress that the sweep leaves first is the preferred pivot, so the fill stays local.
+    // Once every stress has its pivot the earlier rows are all independent and are not looked at: the
+    // rigid-link and tree-joint rows come first and the redundancy almost always lies after them.
+    EliminationOptions options;
+    for (int r = m - 1; r >= 0; --r)
+      options.rowOrder.push_back(r);
+    options.rowScale = Eigen::VectorXd::Ones(m);
+    std::vector<int> byLeaving(numStresses);
+    std::iota(byLeaving.begin(), byLeaving.end(), 0);
+    std::stable_sort(byLeaving.begin(), byLeaving.end(), [&](int a, int b) { return leaves[a] > leaves[b]; });
+    options.columnPriority.assign(numStresses, 0);
+    for (int k = 0; k < numStresses; ++k)
+      options.columnPriority[byLeaving[k]] = k;
+    options.stopAtFullRank = true;
+    const OrderedRank echelon = computeSparseElimination(Y, tolerance, options);
+    if (echelon.rank != numStresses)
+      return std::nullopt;
+    for (int r : options.rowOrder)
+      result.redundant[r] = !echelon.redundant[r];
+    if (echelon.smallestKeptPivot > 0.0) {
+      result.smallestKeptPivot = result.smallestKeptPivot > 0.0
+                                     ? std::min(result.smallestKeptPivot, echelon.smallestKeptPivot)
+                                     : echelon.smallestKeptPivot;
+    }
+    result.largestDroppedResidual = std::max(result.largestDroppedResidual, echelon.largestDroppedResidual);
+  }
+  result.nullityTrace.resize(m);
+  int independent = 0;
+  for (int r = 0; r < m; ++r) {
+    if (!result.redundant[r])
+      ++independent;
+    result.nullityTrace[r] = n - independent;
+  }
+  return result;
+}
+
+}  // namespace mobility_analysis

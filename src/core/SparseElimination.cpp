@@ -1,0 +1,186 @@
+#include "mobility_analysis/SparseElimination.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+#include "mobility_analysis/Tolerances.hpp"
+
+namespace mobility_analysis {
+
+namespace {
+
+/// Entries below this fraction of a reduced row's largest entry are rounding noise and are not stored [-].
+constexpr double kDropTolerance = 1e-15;
+
+/// An entry of a unit-norm row this small at a pivot column is cancellation noise: it is zeroed instead of
+/// eliminated. Without it, noise of 1e-17 would walk the elimination down a whole chain of links (a loop
+/// row's entries cancel exactly at the first common link, but only up to rounding). Six orders below kRank,
+/// so no rank decision can change [-].
+constexpr double kCancellationNoise = 1e-14;
+
+/// Coefficients of a dependency below this are not part of it [-] (rows are scaled to unit norm).
+constexpr double kDependencyCoefficient = 1e-9;
+
+}  // namespace
+
+std::vector<int> supportOf(const SelfStress& stress) {
+  std::vector<int> support;
+  support.reserve(stress.size());
+  for (const auto& entry : stress)
+    support.push_back(entry.first);
+  return support;
+}
+
+SparseElimination::SparseElimination(int numColumns, std::vector<int> columnPriority, double tolerance,
+                                     bool keepMultipliers)
+    : columnPriority_(std::move(columnPriority)),
+      tolerance_(tolerance),
+      keepMultipliers_(keepMultipliers),
+      pivotOfColumn_(numColumns, -1),
+      values_(numColumns, 0.0),
+      present_(numColumns, 0) {}
+
+double SparseElimination::smallestKeptPivot() const {
+  return smallestKept_ < 0.0 ? 0.0 : smallestKept_;
+}
+
+SparseElimination::Step SparseElimination::addRow(const SparseJacobian& J, int r, double scale) {
+  for (int c : touched_) {
+    values_[c] = 0.0;
+    present_[c] = 0;
+  }
+  touched_.clear();
+  multipliers_.clear();
+  auto add = [&](int column, double value) {
+    if (present_[column] == 0) {
+      present_[column] = 1;
+      touched_.push_back(column);
+    }
+    values_[column] += value;
+  };
+  // Pivot indices to reduce by, oldest first: P_k is zero at the pivot columns of earlier pivots, so fill
+  // only ever reaches later ones.
+  std::priority_queue<int, std::vector<int>, std::greater<int>> pending;
+  auto enqueue = [&](int k) {
+    if (queued_[k] == 0) {
+      queued_[k] = 1;
+      pending.push(k);
+    }
+  };
+  if (scale > 0.0) {
+    for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
+      add(static_cast<int>(it.col()), it.value() * scale);
+      const int k = pivotOfColumn_[it.col()];
+      if (k >= 0)
+        enqueue(k);
+    }
+  }
+  visited_.clear();
+  while (!pending.empty()) {
+    const int k = pending.top();
+    pending.pop();
+    visited_.push_back(k);
+    const double value = values_[column_[k]];
+    if (std::abs(value) <= kCancellationNoise) {
+      values_[column_[k]] = 0.0;
+      continue;
+    }
+    const double multiplier = value / pivot_[k];
+    multipliers_.emplace_back(k, multiplier);
+    for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
+      const auto [column, entry] = entries_[i];
+      add(column, -multiplier * entry);
+      const int later = pivotOfColumn_[column];
+      if (later > k)
+        enqueue(later);
+    }
+    values_[column_[k]] = 0.0;
+  }
+  for (int k : visited_)
+    queued_[k] = 0;
+
+  double squared = 0.0, largest = 0.0;
+  for (int c : touched_) {
+    squared += values_[c] * values_[c];
+    largest = std::max(largest, std::abs(values_[c]));
+  }
+  Step step;
+  step.residual = std::sqrt(squared);
+  step.dependent = step.residual <= tolerance_;
+  if (step.dependent) {
+    largestDropped_ = std::max(largestDropped_, step.residual);
+    return step;
+  }
+  smallestKept_ = smallestKept_ < 0.0 ? step.residual : std::min(smallestKept_, step.residual);
+  // Threshold partial pivoting: among entries within kPivotThreshold of the largest, the column of lowest
+  // priority.
+  int pivotColumn = -1;
+  for (int c : touched_) {
+    if (std::abs(values_[c]) >= tolerances::kPivotThreshold * largest &&
+        (pivotColumn < 0 || priority(c) < priority(pivotColumn))) {
+      pivotColumn = c;
+    }
+  }
+  origin_.push_back(r);
+  column_.push_back(pivotColumn);
+  pivot_.push_back(values_[pivotColumn]);
+  for (int c : touched_) {
+    if (std::abs(values_[c]) > kDropTolerance * largest)
+      entries_.emplace_back(c, values_[c]);
+  }
+  entryStart_.push_back(entries_.size());
+  if (keepMultipliers_)
+    pivotMultipliers_.insert(pivotMultipliers_.end(), multipliers_.begin(), multipliers_.end());
+  multiplierStart_.push_back(pivotMultipliers_.size());
+  pivotOfColumn_[pivotColumn] = rank() - 1;
+  queued_.push_back(0);
+  return step;
+}
+
+std::optional<SelfStress> SparseElimination::traceDependency(
+    int row, const std::vector<std::pair<int, double>>& multipliers, size_t maxSupport) {
+  // J_row = sum_k c_k P_k, and each P_k expands into J_origin(k) and earlier pivots: push the coefficients
+  // down from the latest pivot to the first.
+  coefficient_.resize(origin_.size(), 0.0);
+  traced_.resize(origin_.size(), 0);
+  std::priority_queue<int> queue;  // latest pivot first
+  std::vector<int> seen;
+  auto add = [&](int k, double value) {
+    if (traced_[k] == 0) {
+      traced_[k] = 1;
+      queue.push(k);
+      seen.push_back(k);
+    }
+    coefficient_[k] += value;
+  };
+  for (const auto& [k, m] : multipliers)
+    add(k, m);
+  SelfStress stress = {{row, 1.0}};
+  bool complete = true;
+  while (!queue.empty()) {
+    const int k = queue.top();
+    queue.pop();
+    const double c = coefficient_[k];
+    if (std::abs(c) < kDependencyCoefficient)
+      continue;
+    stress.emplace_back(origin_[k], -c);
+    if (maxSupport > 0 && stress.size() > maxSupport) {
+      complete = false;
+      break;
+    }
+    for (size_t i = multiplierStart_[k]; i < multiplierStart_[k + 1]; ++i) {
+      add(pivotMultipliers_[i].first, -c * pivotMultipliers_[i].second);
+    }
+  }
+  for (int k : seen) {
+    coefficient_[k] = 0.0;
+    traced_[k] = 0;
+  }
+  if (!complete)
+    return std::nullopt;
+  std::sort(stress.begin(), stress.end());
+  return stress;
+}
+
+}  // namespace mobility_analysis

@@ -1,0 +1,199 @@
+/// The self-stress basis and the ordered redundancy read off it, against the contract-order elimination and
+/// the dense Gram–Schmidt reference, on hand-made matrices, every bundled mechanism and the generated
+/// families.
+#include "mobility_analysis/SelfStressBasis.hpp"
+
+#include <algorithm>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "core/TestModels.hpp"
+#include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
+#include "mobility_analysis/generators/ParametricFamilies.hpp"
+
+using namespace mobility_analysis;
+
+namespace {
+
+struct Model {
+  Mechanism mechanism;
+  AssembledMechanism assembled;
+  SparseJacobian J;
+};
+
+Model buildModel(Mechanism mechanism, AnalysisMode mode) {
+  Model model;
+  model.mechanism = std::move(mechanism);
+  Result<AssembledMechanism> assembled =
+      assembleMechanism(model.mechanism, computeTreePoses(model.mechanism, {}), mode);
+  EXPECT_TRUE(isOk(assembled)) << diagnosticOf(assembled).toString();
+  model.assembled = valueOf(std::move(assembled));
+  model.J = computeConstraintJacobian(model.assembled.model, model.assembled.q);
+  return model;
+}
+
+Mechanism generated(const MechanismDescription& description) {
+  const GeneratorResult<std::string> urdf = toClosedLoopUrdf(description);
+  EXPECT_TRUE(std::holds_alternative<std::string>(urdf));
+  Result<Mechanism> mechanism =
+      loadMechanismFromString(std::get<std::string>(urdf), description.name + ".urdf");
+  EXPECT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+  return valueOf(std::move(mechanism));
+}
+
+/// y in unscaled rows: the basis works with rows scaled to unit norm.
+Eigen::VectorXd toDense(const SelfStress& stress, const SparseJacobian& J) {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(J.rows());
+  for (const auto& [row, value] : stress)
+    y(row) = value / J.row(row).norm();
+  return y;
+}
+
+/// Every check of the basis and the ordered answer on one model.
+void checkModel(const Model& m, const std::string& name, bool dense) {
+  SCOPED_TRACE(name);
+  const SelfStressBasis basis =
+      computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
+  const OrderedRank direct = computeOrderedRank(m.J, tolerances::kRank, false);
+  ASSERT_EQ(basis.rank, direct.rank);
+  ASSERT_EQ(static_cast<int>(basis.stresses.size()), m.J.rows() - direct.rank);
+
+  // Each is a self-stress, and they are independent: each has a last equation of its own in the sweep.
+  const EliminationOrder order = computeSweepOrder(m.mechanism, m.assembled.model);
+  std::vector<int> position(m.J.rows());
+  for (size_t i = 0; i < order.rows.size(); ++i)
+    position[order.rows[i]] = static_cast<int>(i);
+  std::vector<int> lastRows;
+  for (const SelfStress& stress : basis.stresses) {
+    ASSERT_FALSE(stress.empty());
+    const Eigen::VectorXd y = toDense(stress, m.J);
+    const Eigen::VectorXd load = m.J.transpose() * y;
+    EXPECT_LT(load.norm(), 1e-9 * y.norm() * m.J.norm());
+    int last = stress.front().first;
+    for (const auto& entry : stress) {
+      if (position[entry.first] > position[last])
+        last = entry.first;
+    }
+    lastRows.push_back(last);
+  }
+  std::sort(lastRows.begin(), lastRows.end());
+  EXPECT_EQ(std::adjacent_find(lastRows.begin(), lastRows.end()), lastRows.end());
+
+  const std::optional<OrderedRank> fromStresses = computeOrderedRankFromStresses(basis, tolerances::kRank);
+  ASSERT_TRUE(fromStresses.has_value());
+  EXPECT_EQ(fromStresses->redundant, direct.redundant);
+  EXPECT_EQ(fromStresses->nullityTrace, direct.nullityTrace);
+  EXPECT_EQ(fromStresses->dof(), direct.dof());
+  if (dense) {
+    const OrderedRank reference = computeOrderedRankDense(Eigen::MatrixXd(m.J), tolerances::kRank);
+    EXPECT_EQ(fromStresses->redundant, reference.redundant);
+    EXPECT_EQ(fromStresses->nullityTrace, reference.nullityTrace);
+  }
+}
+
+}  // namespace
+
+TEST(SelfStressBasis, OrderedRankFromAnyBasisEqualsTheDenseReferenceOnRandomMatrices) {
+  // The echelon argument does not depend on where the basis came from: find one in a random row order.
+  std::mt19937 random(11);
+  std::uniform_int_distribution<int> pick(0, 9);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int n = 12, m = 20;
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m, n);
+    for (int r = 0; r < m; ++r) {
+      if (r >= 4 && pick(random) < 5) {
+        const int a = pick(random) % r, b = (pick(random) + 3) % r;
+        J.row(r) = normal(random) * J.row(a) + normal(random) * J.row(b);
+      } else {
+        for (int k = 0; k < 3; ++k)
+          J(r, (r + 4 * k + pick(random)) % n) = normal(random);
+      }
+    }
+    const SparseJacobian sparse = J.sparseView();
+    EliminationOptions options;
+    options.rowOrder.resize(m);
+    std::iota(options.rowOrder.begin(), options.rowOrder.end(), 0);
+    std::shuffle(options.rowOrder.begin(), options.rowOrder.end(), random);
+    options.computeDependencies = true;
+    const OrderedRank shuffled = computeSparseElimination(sparse, 1e-9, options);
+    SelfStressBasis basis;
+    basis.stresses = shuffled.dependencies;
+    basis.numConstraints = m;
+    basis.numCoordinates = n;
+    basis.rank = shuffled.rank;
+    const std::optional<OrderedRank> fromStresses = computeOrderedRankFromStresses(basis, 1e-9);
+    ASSERT_TRUE(fromStresses.has_value()) << "trial " << trial;
+    const OrderedRank dense = computeOrderedRankDense(J, 1e-9);
+    EXPECT_EQ(fromStresses->redundant, dense.redundant) << "trial " << trial;
+    EXPECT_EQ(fromStresses->nullityTrace, dense.nullityTrace) << "trial " << trial;
+  }
+}
+
+TEST(SelfStressBasis, NoStressMeansNothingRedundant) {
+  const Model m = buildModel(loadOrFail(urdfPath("puma560.urdf")), AnalysisMode::Spatial);
+  const SelfStressBasis basis =
+      computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
+  EXPECT_TRUE(basis.stresses.empty());
+  const std::optional<OrderedRank> ranks = computeOrderedRankFromStresses(basis, tolerances::kRank);
+  ASSERT_TRUE(ranks.has_value());
+  EXPECT_EQ(std::count(ranks->redundant.begin(), ranks->redundant.end(), true), 0);
+  EXPECT_EQ(ranks->dof(), 6);
+}
+
+TEST(SelfStressBasis, EqualsContractOrderAndDenseOnEveryBundledMechanism) {
+  for (const char* file :
+       {"four_bar.urdf", "puma560.urdf", "parallelogram_crank.urdf", "three_sliders.urdf", "rppr.urdf",
+        "bennett.urdf", "bennett_mm.urdf", "door.urdf", "sarrus.urdf", "bricard.urdf", "goldberg.urdf",
+        "rssr.urdf", "sle_mast.urdf", "hoberman_ring.urdf"}) {
+    for (AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial}) {
+      checkModel(buildModel(loadOrFail(urdfPath(file)), mode), std::string(file) + " " + toString(mode),
+                 true);
+    }
+  }
+}
+
+TEST(SelfStressBasis, EqualsContractOrderAndDenseOnTheGeneratedFamilies) {
+  for (int n : {1, 2, 5, 12}) {
+    checkModel(buildModel(generated(makeSlePlanarMast(n)), AnalysisMode::Planar), "sle_planar planar",
+               n <= 5);
+    checkModel(buildModel(generated(makeSlePlanarMast(n)), AnalysisMode::Spatial), "sle_planar spatial",
+               n <= 5);
+    checkModel(buildModel(generated(makeHobermanRing(n + 3)), AnalysisMode::Planar), "hoberman planar",
+               n <= 5);
+    checkModel(buildModel(generated(makeHobermanRing(n + 3)), AnalysisMode::Spatial), "hoberman spatial",
+               n <= 5);
+    checkModel(buildModel(generated(makeDoor(n + 1)), AnalysisMode::Spatial), "door spatial", true);
+  }
+  for (int n : {1, 2, 4}) {
+    checkModel(buildModel(generated(makeSleSpatialMast(n)), AnalysisMode::Spatial), "sle_spatial", n <= 2);
+    checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Planar), "grid planar",
+               true);
+    checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Spatial), "grid spatial",
+               n <= 2);
+  }
+}
+
+TEST(SelfStressBasis, StressesStayLocalAlongAChainOfLoops) {
+  // A mast analysed in space: 3 stresses per unit, each over a few units' equations, however tall the mast.
+  // The stress the sweep traces first runs down to the ground (quadratic in all); the local elimination
+  // replaces it.
+  size_t largest = 0, total[2] = {0, 0};
+  int k = 0;
+  for (int units : {20, 60}) {
+    const Model m = buildModel(generated(makeSlePlanarMast(units)), AnalysisMode::Spatial);
+    const SelfStressBasis basis =
+        computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
+    ASSERT_EQ(static_cast<int>(basis.stresses.size()), 3 * units);
+    EXPECT_GT(basis.locallyResolved, 0);
+    for (const SelfStress& stress : basis.stresses) {
+      largest = std::max(largest, stress.size());
+      total[k] += stress.size();
+    }
+    ++k;
+  }
+  EXPECT_LT(largest, 200u);
+  EXPECT_LT(total[1], 3.3 * total[0])
+      << "the stresses grow with the mast: " << total[0] << " -> " << total[1];
+}
