@@ -29,11 +29,11 @@ const char* toString(EquationSource source);
  * @brief A basic point or unit vector of one body: the natural coordinates (García de Jalón & Bayo, ch. 3).
  */
 struct Element {
-  int body = -1;                 ///< Link index.
-  bool isPoint = true;           ///< Point or unit vector.
-  Eigen::Vector3d local;         ///< In the body frame, point divided by the characteristic length.
-  int offset = 0;                ///< First coordinate in q.
-  std::string label;             ///< "P(crank@j2)", "u(crank@j2)", "aux1(rod)".
+  int body = -1;          ///< Link index.
+  bool isPoint = true;    ///< Point or unit vector.
+  Eigen::Vector3d local;  ///< In the body frame, point divided by the characteristic length.
+  int offset = 0;         ///< First coordinate in q.
+  std::string label;      ///< "P(crank@j2)", "u(crank@j2)", "aux1(rod)".
 };
 
 /// A vector of the body as a function of q: element `head`, minus point `tail` when tail >= 0.
@@ -47,7 +47,8 @@ enum class EquationForm {
   Dot,          ///< a·b - value
   Cross,        ///< (a x b)_component - value; planar: a_x b_y - a_y b_x - value
   Component,    ///< a_component - value
-  Combination,  ///< (x_target - x_origin - c0 d1 - c1 d2 - c2 d1 x d2)_component; planar: d2 := J d1, no c2 term
+  Combination,  ///< (x_target - x_origin - c0 d1 - c1 d2 - c2 d1 x d2)_component; planar: d2 := J d1, no c2
+                ///< term
 };
 
 /// What an equation means, for names and for tests.
@@ -75,30 +76,30 @@ struct ConstraintEquation {
   EquationKind kind = EquationKind::LinkDistance;
   EquationForm form = EquationForm::Dot;
   int component = 0;
-  Direction a, b;             ///< Operands (Dot, Cross: a and b; Component: a).
-  int target = -1;            ///< Combination: the element expressed.
-  int origin = -1;            ///< Combination: the body's base point (points only), else -1.
-  Direction d1, d2;           ///< Combination: the body's basis directions (planar: d2 unused).
+  Direction a, b;    ///< Operands (Dot, Cross: a and b; Component: a).
+  int target = -1;   ///< Combination: the element expressed.
+  int origin = -1;   ///< Combination: the body's base point (points only), else -1.
+  Direction d1, d2;  ///< Combination: the body's basis directions (planar: d2 unused).
   Eigen::Vector3d coefficients = Eigen::Vector3d::Zero();  ///< Combination: c0, c1, c2.
-  double value = 0.0;         ///< Dot, Cross, Component: the constant.
-  std::string text;           ///< Readable form, e.g. "|P(crank@j2) - P(crank@j1)|^2 = 1".
+  double value = 0.0;                                      ///< Dot, Cross, Component: the constant.
+  std::string text;  ///< Readable form, e.g. "|P(crank@j2) - P(crank@j1)|^2 = 1".
 };
 
 /// The mechanism in natural coordinates: elements, their coordinates at the assembled pose and the equations.
 struct CoordinateModel {
-  int dim = 3;                           ///< 3 spatial, 2 planar.
-  int lambda = 6;                        ///< 6 spatial, 3 planar.
-  AnalysisMode mode = AnalysisMode::Spatial;  ///< Planar or Spatial (never Auto).
+  int dim = 3;                                             ///< 3 spatial, 2 planar.
+  int lambda = 6;                                          ///< 6 spatial, 3 planar.
+  AnalysisMode mode = AnalysisMode::Spatial;               ///< Planar or Spatial (never Auto).
   Eigen::Vector3d planeNormal = Eigen::Vector3d::UnitZ();  ///< Planar: normal; (e1, e2) span the plane.
   Eigen::Vector3d planeE1 = Eigen::Vector3d::UnitX();
   Eigen::Vector3d planeE2 = Eigen::Vector3d::UnitY();
-  double characteristicLength = 1.0;     ///< [m] lengths are divided by it.
+  double characteristicLength = 1.0;  ///< [m] lengths are divided by it.
   std::vector<Element> elements;
   std::vector<ConstraintEquation> equations;  ///< In contract order: links, joints, boundary.
-  std::vector<int> jointFreedom;         ///< F_i of each connection in this mode (-1: ignored, e.g. slack cable).
-  std::vector<bool> jointActive;         ///< Whether a connection contributes equations (cables: taut passive).
+  std::vector<int> jointFreedom;  ///< F_i of each connection in this mode (-1: ignored, e.g. slack cable).
+  std::vector<bool> jointActive;  ///< Whether a connection contributes equations (cables: taut passive).
   std::vector<std::vector<int>> bodyElements;  ///< Element indices of each link.
-  Eigen::VectorXd q0;                    ///< Coordinates at the pose the model was built at (dim num_coordinates).
+  Eigen::VectorXd q0;  ///< Coordinates at the pose the model was built at (dim num_coordinates).
   int numCoordinates() const { return static_cast<int>(q0.size()); }
   int numConstraints() const { return static_cast<int>(equations.size()); }
 };
@@ -107,7 +108,8 @@ struct CoordinateModel {
 std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const LinkPoses& poses);
 
 /**
- * @brief Converts the mechanism at @p poses to natural coordinates and writes the equations in contract order.
+ * @brief Converts the mechanism at @p poses to natural coordinates and writes the equations in contract
+ * order.
  *
  * Rigid links: a base point p0 and directions d1, d2 (planar: d1), with d_i·d_j fixed (3 or 1 equations), and
  * every other element a linear combination of them (3 or 2 equations each), so each body keeps exactly
@@ -119,8 +121,8 @@ std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const
  * @param[in] characteristicLength [m] (see computeCharacteristicLength).
  * @return The model, or a Diagnostic (e.g. a revolute axis not normal to the plane in planar mode).
  */
-Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const LinkPoses& poses, AnalysisMode mode,
-                                             double characteristicLength);
+Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const LinkPoses& poses,
+                                             AnalysisMode mode, double characteristicLength);
 
 /**
  * @brief Natural coordinates of every element at @p poses in @p model's space (projected for planar models).

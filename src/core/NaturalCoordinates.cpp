@@ -11,43 +11,64 @@ namespace mobility_analysis {
 
 const char* toString(AnalysisMode mode) {
   switch (mode) {
-    case AnalysisMode::Auto: return "auto";
-    case AnalysisMode::Planar: return "planar";
-    case AnalysisMode::Spatial: return "spatial";
+    case AnalysisMode::Auto:
+      return "auto";
+    case AnalysisMode::Planar:
+      return "planar";
+    case AnalysisMode::Spatial:
+      return "spatial";
   }
   return "unknown";
 }
 
 Result<AnalysisMode> parseAnalysisMode(const std::string& text) {
-  if (text == "auto" || text.empty()) return AnalysisMode::Auto;
-  if (text == "planar") return AnalysisMode::Planar;
-  if (text == "spatial") return AnalysisMode::Spatial;
+  if (text == "auto" || text.empty())
+    return AnalysisMode::Auto;
+  if (text == "planar")
+    return AnalysisMode::Planar;
+  if (text == "spatial")
+    return AnalysisMode::Spatial;
   return makeDiagnostic("", "mode", text, "is not one of auto, planar, spatial");
 }
 
 const char* toString(EquationSource source) {
   switch (source) {
-    case EquationSource::Link: return "link";
-    case EquationSource::Joint: return "joint";
-    case EquationSource::Boundary: return "boundary";
+    case EquationSource::Link:
+      return "link";
+    case EquationSource::Joint:
+      return "joint";
+    case EquationSource::Boundary:
+      return "boundary";
   }
   return "unknown";
 }
 
 const char* toString(EquationKind kind) {
   switch (kind) {
-    case EquationKind::LinkDistance: return "distance";
-    case EquationKind::UnitNorm: return "unit_norm";
-    case EquationKind::LinkDotProduct: return "dot_product";
-    case EquationKind::LinearCombination: return "linear_combination";
-    case EquationKind::CoincidentPoint: return "coincident_point";
-    case EquationKind::ParallelAxis: return "parallel_axis";
-    case EquationKind::PointOnAxisLine: return "point_on_axis_line";
-    case EquationKind::FixedTwist: return "fixed_twist";
-    case EquationKind::AxisAngle: return "axis_angle";
-    case EquationKind::PointInPlane: return "point_in_plane";
-    case EquationKind::Distance: return "distance_constraint";
-    case EquationKind::FixedCoordinate: return "fixed_coordinate";
+    case EquationKind::LinkDistance:
+      return "distance";
+    case EquationKind::UnitNorm:
+      return "unit_norm";
+    case EquationKind::LinkDotProduct:
+      return "dot_product";
+    case EquationKind::LinearCombination:
+      return "linear_combination";
+    case EquationKind::CoincidentPoint:
+      return "coincident_point";
+    case EquationKind::ParallelAxis:
+      return "parallel_axis";
+    case EquationKind::PointOnAxisLine:
+      return "point_on_axis_line";
+    case EquationKind::FixedTwist:
+      return "fixed_twist";
+    case EquationKind::AxisAngle:
+      return "axis_angle";
+    case EquationKind::PointInPlane:
+      return "point_in_plane";
+    case EquationKind::Distance:
+      return "distance_constraint";
+    case EquationKind::FixedCoordinate:
+      return "fixed_coordinate";
   }
   return "unknown";
 }
@@ -72,15 +93,19 @@ bool isSpatialOnly(JointType type) {
 Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const LinkPoses& poses) {
   std::vector<Eigen::Vector3d> slides;
   for (const Joint& joint : mechanism.joints) {
-    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable) continue;
+    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable)
+      continue;
     const Eigen::Vector3d axis = worldAxes(joint, poses).first;
-    if (joint.type == JointType::Revolute || joint.type == JointType::Continuous) return axis;
-    if (joint.type == JointType::Prismatic) slides.push_back(axis);
+    if (joint.type == JointType::Revolute || joint.type == JointType::Continuous)
+      return axis;
+    if (joint.type == JointType::Prismatic)
+      slides.push_back(axis);
   }
   for (size_t i = 0; i < slides.size(); ++i) {
     for (size_t j = i + 1; j < slides.size(); ++j) {
       const Eigen::Vector3d n = slides[i].cross(slides[j]);
-      if (n.norm() > tolerances::kIndependentDirection) return n.normalized();
+      if (n.norm() > tolerances::kIndependentDirection)
+        return n.normalized();
     }
   }
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
@@ -103,8 +128,9 @@ struct ElementBuilder {
     e.local = local;
     e.label = std::move(label);
     model.elements.push_back(e);
-    world.push_back(isPoint ? (poses[body].linear() * local + poses[body].translation() / model.characteristicLength)
-                            : (poses[body].linear() * local).eval());
+    world.push_back(
+        isPoint ? (poses[body].linear() * local + poses[body].translation() / model.characteristicLength)
+                : (poses[body].linear() * local).eval());
     model.bodyElements[body].push_back(static_cast<int>(model.elements.size()) - 1);
     return static_cast<int>(model.elements.size()) - 1;
   }
@@ -134,7 +160,8 @@ std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const
   }
   const Eigen::Vector3d normal = candidateNormal(mechanism, poses);
   for (const Joint& joint : mechanism.joints) {
-    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable) continue;
+    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable)
+      continue;
     const auto axes = worldAxes(joint, poses);
     if (classifyPlanar(joint, axes.first, axes.second, normal) == PlanarForm::Invalid) {
       return std::nullopt;
@@ -143,8 +170,8 @@ std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const
   return normal;
 }
 
-Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const LinkPoses& poses, AnalysisMode mode,
-                                             double characteristicLength) {
+Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const LinkPoses& poses,
+                                             AnalysisMode mode, double characteristicLength) {
   CoordinateModel model;
   model.characteristicLength = characteristicLength;
   const std::optional<Eigen::Vector3d> planeNormal = findPlaneNormal(mechanism, poses);
@@ -156,7 +183,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
   if (planar) {
     model.planeNormal = planeNormal ? *planeNormal : candidateNormal(mechanism, poses);
     // e1 along the root's x projected into the plane, so the planar coordinates read like the URDF's.
-    Eigen::Vector3d e1 = Eigen::Vector3d::UnitX() - model.planeNormal.dot(Eigen::Vector3d::UnitX()) * model.planeNormal;
+    Eigen::Vector3d e1 =
+        Eigen::Vector3d::UnitX() - model.planeNormal.dot(Eigen::Vector3d::UnitX()) * model.planeNormal;
     if (e1.norm() < tolerances::kIndependentDirection) {
       e1 = model.planeNormal.unitOrthogonal();
     }
@@ -179,12 +207,14 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable) {
       if (joint.kind == ConnectionKind::Cable) {
         const double distance = ((poses[joint.link1] * joint.frame1.translation()) -
-                                 (poses[joint.link2] * joint.frame2.translation())).norm();
+                                 (poses[joint.link2] * joint.frame2.translation()))
+                                    .norm();
         const bool taut = std::abs(distance - joint.length) <= tolerances::kCableTaut * joint.length;
-        if (joint.cableType == CableType::Passive && distance > joint.length * (1.0 + tolerances::kCableTaut)) {
+        if (joint.cableType == CableType::Passive &&
+            distance > joint.length * (1.0 + tolerances::kCableTaut)) {
           char what[160];
-          std::snprintf(what, sizeof(what), "its ends are %.6g m apart, longer than its length %.6g m", distance,
-                        joint.length);
+          std::snprintf(what, sizeof(what), "its ends are %.6g m apart, longer than its length %.6g m",
+                        distance, joint.length);
           return makeDiagnostic(mechanism.file, "cable", joint.name, what);
         }
         if (joint.cableType == CableType::Active || !taut) {
@@ -199,11 +229,12 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
       const PlanarForm form = classifyPlanar(joint, axes.first, axes.second, model.planeNormal);
       if (form == PlanarForm::Invalid) {
         char what[240];
-        std::snprintf(what, sizeof(what),
-                      "%s axis (%.3g, %.3g, %.3g) does not allow motion in the plane with normal (%.3g, %.3g, %.3g); "
-                      "analyse it with mode spatial",
-                      toString(joint.type), axes.first.x(), axes.first.y(), axes.first.z(), model.planeNormal.x(),
-                      model.planeNormal.y(), model.planeNormal.z());
+        std::snprintf(
+            what, sizeof(what),
+            "%s axis (%.3g, %.3g, %.3g) does not allow motion in the plane with normal (%.3g, %.3g, %.3g); "
+            "analyse it with mode spatial",
+            toString(joint.type), axes.first.x(), axes.first.y(), axes.first.z(), model.planeNormal.x(),
+            model.planeNormal.y(), model.planeNormal.z());
         return makeDiagnostic(mechanism.file, toString(joint.kind), joint.name, what);
       }
       c.primitives = planarPrimitives(form);
@@ -223,16 +254,20 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     const std::string& n1 = mechanism.links[joint.link1].name;
     const std::string& n2 = mechanism.links[joint.link2].name;
     if (needPoints) {
-      c.point1 = builder.add(joint.link1, true, joint.frame1.translation() / lc, "P(" + n1 + "@" + joint.name + ")");
-      c.point2 = builder.add(joint.link2, true, joint.frame2.translation() / lc, "P(" + n2 + "@" + joint.name + ")");
+      c.point1 =
+          builder.add(joint.link1, true, joint.frame1.translation() / lc, "P(" + n1 + "@" + joint.name + ")");
+      c.point2 =
+          builder.add(joint.link2, true, joint.frame2.translation() / lc, "P(" + n2 + "@" + joint.name + ")");
     }
     if (needAxes || needAxis1) {
-      c.axis1 = builder.add(joint.link1, false, joint.frame1.linear() * joint.axis, "u(" + n1 + "@" + joint.name + ")");
+      c.axis1 = builder.add(joint.link1, false, joint.frame1.linear() * joint.axis,
+                            "u(" + n1 + "@" + joint.name + ")");
     }
     if (needAxes) {
       const bool universal = joint.type == JointType::Universal;
-      c.axis2 = builder.add(joint.link2, false, joint.frame2.linear() * (universal ? joint.axis2 : joint.axis),
-                            (universal ? "v(" : "u(") + n2 + "@" + joint.name + ")");
+      c.axis2 =
+          builder.add(joint.link2, false, joint.frame2.linear() * (universal ? joint.axis2 : joint.axis),
+                      (universal ? "v(" : "u(") + n2 + "@" + joint.name + ")");
     }
   }
 
@@ -249,7 +284,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
                       : "(" + model.elements[d.head].label + " - " + model.elements[d.tail].label + ")";
   };
 
-  // 2. Body bases: p0 and the best-conditioned directions; auxiliary unit vectors where the joints give too few.
+  // 2. Body bases: p0 and the best-conditioned directions; auxiliary unit vectors where the joints give too
+  // few.
   std::vector<BodyBasis> bases(mechanism.links.size());
   for (size_t b = 0; b < mechanism.links.size(); ++b) {
     const int body = static_cast<int>(b);
@@ -266,7 +302,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     }
     std::vector<Direction> candidates;
     for (int e : model.bodyElements[b]) {
-      if (e == basis.p0) continue;
+      if (e == basis.p0)
+        continue;
       candidates.push_back(Direction{e, model.elements[e].isPoint ? basis.p0 : -1});
     }
     double best = tolerances::kIndependentDirection;
@@ -284,7 +321,7 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
       if (planar) {
         const Eigen::Vector3d n = rotation.transpose() * model.planeNormal;
         local = (local - n.dot(local) * n).norm() > 0.5 ? (local - n.dot(local) * n).normalized().eval()
-                                                         : n.unitOrthogonal();
+                                                        : n.unitOrthogonal();
       }
       basis.d1 = Direction{builder.add(body, false, local, "aux1(" + name + ")"), -1};
     }
@@ -292,7 +329,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
       const Eigen::Vector3d d1 = directionValue(basis.d1);
       double bestSine = tolerances::kIndependentDirection;
       for (const Direction& d : candidates) {
-        if (d.head == basis.d1.head) continue;
+        if (d.head == basis.d1.head)
+          continue;
         const Eigen::Vector3d v = directionValue(d);
         const double perpendicular = d1.cross(v).norm() / d1.norm();
         const double sine = perpendicular / std::max(v.norm(), 1e-300);
@@ -304,7 +342,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
       if (basis.d2.head < 0) {
         // A rod, or a body whose joint elements are all on one line: its spin needs a second direction.
         const Eigen::Vector3d worldAux = d1.unitOrthogonal();
-        basis.d2 = Direction{builder.add(body, false, rotation.transpose() * worldAux, "aux2(" + name + ")"), -1};
+        basis.d2 =
+            Direction{builder.add(body, false, rotation.transpose() * worldAux, "aux2(" + name + ")"), -1};
       }
     }
   }
@@ -325,8 +364,10 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
       }
     }
     auto remap = [&](Direction& d) {
-      if (d.head >= 0) d.head = newIndex[d.head];
-      if (d.tail >= 0) d.tail = newIndex[d.tail];
+      if (d.head >= 0)
+        d.head = newIndex[d.head];
+      if (d.tail >= 0)
+        d.tail = newIndex[d.tail];
     };
     for (BodyBasis& basis : bases) {
       basis.p0 = newIndex[basis.p0];
@@ -335,11 +376,13 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     }
     for (ConnectionElements& c : connections) {
       for (int* e : {&c.point1, &c.point2, &c.axis1, &c.axis2}) {
-        if (*e >= 0) *e = newIndex[*e];
+        if (*e >= 0)
+          *e = newIndex[*e];
       }
     }
     for (std::vector<int>& list : model.bodyElements) {
-      for (int& e : list) e = newIndex[e];
+      for (int& e : list)
+        e = newIndex[e];
     }
     model.elements = std::move(ordered);
     builder.world = std::move(orderedWorld);
@@ -360,7 +403,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
   for (size_t b = 0; b < mechanism.links.size(); ++b) {
     const BodyBasis& basis = bases[b];
     std::vector<Direction> dirs = {basis.d1};
-    if (!planar) dirs.push_back(basis.d2);
+    if (!planar)
+      dirs.push_back(basis.d2);
     for (size_t i = 0; i < dirs.size(); ++i) {
       for (size_t j = i; j < dirs.size(); ++j) {
         ConstraintEquation eq;
@@ -399,7 +443,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     }
     const Eigen::PartialPivLU<Eigen::Matrix3d> lu(frame);
     for (int e : model.bodyElements[b]) {
-      if (e == basis.p0 || e == basis.d1.head || (!planar && e == basis.d2.head)) continue;
+      if (e == basis.p0 || e == basis.d1.head || (!planar && e == basis.d2.head))
+        continue;
       const bool isPoint = model.elements[e].isPoint;
       const Eigen::Vector3d rhs = isPoint ? (coordinates(e) - coordinates(basis.p0)).eval() : coordinates(e);
       const Eigen::Vector3d coefficients = lu.solve(rhs);
@@ -415,10 +460,13 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
         eq.d1 = basis.d1;
         eq.d2 = basis.d2;
         eq.coefficients = coefficients;
-        if (planar) eq.coefficients.z() = 0.0;
+        if (planar)
+          eq.coefficients.z() = 0.0;
         std::string text = model.elements[e].label + " = ";
-        if (isPoint) text += model.elements[basis.p0].label + " + ";
-        text += format(eq.coefficients.x()) + " " + directionName(basis.d1) + " + " + format(eq.coefficients.y()) +
+        if (isPoint)
+          text += model.elements[basis.p0].label + " + ";
+        text += format(eq.coefficients.x()) + " " + directionName(basis.d1) + " + " +
+                format(eq.coefficients.y()) +
                 (planar ? " J" + directionName(basis.d1)
                         : " " + directionName(basis.d2) + " + " + format(eq.coefficients.z()) + " d1 x d2");
         eq.text = text + " (" + kAxisNames[k] + ")";
@@ -429,7 +477,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
 
   // 5. Joint equations: tree joints, distance constraints, cables, loop joints (the loader's order).
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
-    if (!model.jointActive[j]) continue;
+    if (!model.jointActive[j])
+      continue;
     const Joint& joint = mechanism.joints[j];
     const ConnectionElements& c = connections[j];
     auto base = [&](EquationKind kind, EquationForm form) {
@@ -443,12 +492,14 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     // Cross-product components: drop the one along the axis' largest component (it is degenerate there).
     auto crossComponents = [&](int axisElement) {
       std::vector<int> components;
-      if (planar) return std::vector<int>{2};
+      if (planar)
+        return std::vector<int>{2};
       const Eigen::Vector3d axis = coordinates(axisElement);
       int largest = 0;
       axis.cwiseAbs().maxCoeff(&largest);
       for (int k = 0; k < 3; ++k) {
-        if (k != largest) components.push_back(k);
+        if (k != largest)
+          components.push_back(k);
       }
       return components;
     };
@@ -468,8 +519,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
         case Primitive::PointOnAxisLine:
           for (int k : crossComponents(c.axis1)) {
             const bool parallel = primitive == Primitive::ParallelAxis;
-            ConstraintEquation eq =
-                base(parallel ? EquationKind::ParallelAxis : EquationKind::PointOnAxisLine, EquationForm::Cross);
+            ConstraintEquation eq = base(
+                parallel ? EquationKind::ParallelAxis : EquationKind::PointOnAxisLine, EquationForm::Cross);
             eq.a = Direction{c.axis1, -1};
             eq.b = parallel ? Direction{c.axis2, -1} : Direction{c.point2, c.point1};
             eq.component = k;
@@ -491,15 +542,17 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
           }
           // B's directions as they are when the two joint frames are aligned (the joint's rest orientation).
           const Eigen::Matrix3d aligned = poses[joint.link1].linear() * joint.frame1.linear() *
-                                          joint.frame2.linear().transpose() * poses[joint.link2].linear().transpose();
+                                          joint.frame2.linear().transpose() *
+                                          poses[joint.link2].linear().transpose();
           auto project = [&](const Eigen::Vector3d& w) {
             return planar ? Eigen::Vector3d(w.dot(model.planeE1), w.dot(model.planeE2), 0.0) : w;
           };
           auto worldOf = [&](const Direction& d) {
-            return d.tail < 0 ? builder.world[d.head] : (builder.world[d.head] - builder.world[d.tail]).eval();
+            return d.tail < 0 ? builder.world[d.head]
+                              : (builder.world[d.head] - builder.world[d.tail]).eval();
           };
-          // Two candidate forms per pair: a.b (rate n.(b x a)) and (a x b)_k (rate (n (a.b) - b (a.n))_k), so a
-          // pair of directions parallel to each other (two axes along the same normal) still sees the turn.
+          // Two candidate forms per pair: a.b (rate n.(b x a)) and (a x b)_k (rate (n (a.b) - b (a.n))_k), so
+          // a pair of directions parallel to each other (two axes along the same normal) still sees the turn.
           double best = -1.0;
           ConstraintEquation eq = base(EquationKind::FixedTwist, EquationForm::Dot);
           for (const Direction& da : dirsA) {
@@ -515,8 +568,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
                 eq.b = db;
                 eq.value = va.dot(vb);
               }
-              // In space a cross component is invariant under a rigid motion of the whole mechanism only where
-              // a x b = 0, so that form is used for parallel pairs alone (in the plane it always is).
+              // In space a cross component is invariant under a rigid motion of the whole mechanism only
+              // where a x b = 0, so that form is used for parallel pairs alone (in the plane it always is).
               const bool parallel = va.cross(vb).norm() <= 1e-9 * scale;
               const Eigen::Vector3d crossRate = (n * va.dot(vb) - vb * va.dot(n)) / scale;
               for (int k = planar ? 2 : 0; k < 3 && (planar || parallel); ++k) {
@@ -535,8 +588,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
           eq.text = eq.form == EquationForm::Dot
                         ? directionName(eq.a) + "." + directionName(eq.b) + " = " + format(eq.value)
                         : "(" + directionName(eq.a) + " x " + directionName(eq.b) + ")" +
-                              (planar ? std::string("") : std::string("_") + kAxisNames[eq.component]) + " = " +
-                              format(eq.value);
+                              (planar ? std::string("") : std::string("_") + kAxisNames[eq.component]) +
+                              " = " + format(eq.value);
           addEquation(eq);
           break;
         }
@@ -562,7 +615,8 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
           ConstraintEquation eq = base(EquationKind::Distance, EquationForm::Dot);
           eq.a = Direction{c.point2, c.point1};
           eq.b = eq.a;
-          const double length = joint.kind == ConnectionKind::Cable ? joint.length / lc : directionValue(eq.a).norm();
+          const double length =
+              joint.kind == ConnectionKind::Cable ? joint.length / lc : directionValue(eq.a).norm();
           eq.value = length * length;
           eq.text = "|" + model.elements[c.point2].label + " - " + model.elements[c.point1].label +
                     "|^2 = " + format(eq.value) + " Lc^2";
@@ -632,10 +686,11 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
 Eigen::VectorXd computeCoordinates(const CoordinateModel& model, const LinkPoses& poses) {
   Eigen::VectorXd q(model.numCoordinates());
   for (const Element& e : model.elements) {
-    const Eigen::Vector3d w = e.isPoint ? (poses[e.body].linear() * e.local +
-                                           poses[e.body].translation() / model.characteristicLength)
-                                              .eval()
-                                        : (poses[e.body].linear() * e.local).eval();
+    const Eigen::Vector3d w =
+        e.isPoint
+            ? (poses[e.body].linear() * e.local + poses[e.body].translation() / model.characteristicLength)
+                  .eval()
+            : (poses[e.body].linear() * e.local).eval();
     if (model.dim == 3) {
       q.segment<3>(e.offset) = w;
     } else {
@@ -667,7 +722,8 @@ LinkPoses recoverPoses(const CoordinateModel& model, const Eigen::Ref<const Eige
       (element.isPoint ? localPoints : localVectors).push_back(element.local);
       (element.isPoint ? worldPoints : worldVectors).push_back(w);
     }
-    if (localPoints.empty()) continue;
+    if (localPoints.empty())
+      continue;
     Eigen::Vector3d localCentroid = Eigen::Vector3d::Zero(), worldCentroid = Eigen::Vector3d::Zero();
     for (size_t i = 0; i < localPoints.size(); ++i) {
       localCentroid += localPoints[i];

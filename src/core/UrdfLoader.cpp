@@ -74,8 +74,8 @@ class LoopElementReader {
     return value;
   }
 
-  Result<Eigen::Vector3d> parseAxis(const tinyxml2::XMLElement* element, const char* tag, const std::string& kind,
-                                    const std::string& name) const {
+  Result<Eigen::Vector3d> parseAxis(const tinyxml2::XMLElement* element, const char* tag,
+                                    const std::string& kind, const std::string& name) const {
     const tinyxml2::XMLElement* axisElement = element->FirstChildElement(tag);
     if (axisElement == nullptr) {
       return std::string(tag) == "axis" ? Eigen::Vector3d::UnitX().eval() : Eigen::Vector3d::UnitY().eval();
@@ -135,13 +135,20 @@ class LoopElementReader {
 
 Result<JointType> parseLoopJointType(const char* text) {
   const std::string type = text == nullptr ? "" : text;
-  if (type == "revolute") return JointType::Revolute;
-  if (type == "continuous") return JointType::Continuous;
-  if (type == "prismatic") return JointType::Prismatic;
-  if (type == "cylindrical") return JointType::Cylindrical;
-  if (type == "spherical") return JointType::Spherical;
-  if (type == "universal") return JointType::Universal;
-  if (type == "fixed") return JointType::Fixed;
+  if (type == "revolute")
+    return JointType::Revolute;
+  if (type == "continuous")
+    return JointType::Continuous;
+  if (type == "prismatic")
+    return JointType::Prismatic;
+  if (type == "cylindrical")
+    return JointType::Cylindrical;
+  if (type == "spherical")
+    return JointType::Spherical;
+  if (type == "universal")
+    return JointType::Universal;
+  if (type == "fixed")
+    return JointType::Fixed;
   return Diagnostic{};
 }
 
@@ -152,9 +159,9 @@ std::string baseName(const std::string& path) {
 
 Eigen::Isometry3d toIsometry(const urdf::Pose& pose) {
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
-  frame.linear() =
-      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z).normalized()
-          .toRotationMatrix();
+  frame.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+                       .normalized()
+                       .toRotationMatrix();
   frame.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
   return frame;
 }
@@ -166,7 +173,8 @@ Result<Mechanism> readTree(const tinyxml2::XMLElement* robot, const LoopElementR
   mechanism.file = file;
   const char* robotName = robot->Attribute("name");
   mechanism.name = robotName == nullptr ? "" : robotName;
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e; e = e->NextSiblingElement("link")) {
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e;
+       e = e->NextSiblingElement("link")) {
     const char* name = e->Attribute("name");
     if (name == nullptr || std::string(name).empty()) {
       return reader.error("link", "", "has no name");
@@ -181,7 +189,8 @@ Result<Mechanism> readTree(const tinyxml2::XMLElement* robot, const LoopElementR
   }
   std::vector<int> parentOf(mechanism.links.size(), -1);
   std::set<std::string> names;
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) {
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("joint"); e;
+       e = e->NextSiblingElement("joint")) {
     const char* name = e->Attribute("name");
     if (name == nullptr || std::string(name).empty()) {
       return reader.error("joint", "", "has no name");
@@ -200,10 +209,12 @@ Result<Mechanism> readTree(const tinyxml2::XMLElement* robot, const LoopElementR
     const std::optional<int> parentLink = mechanism.findLink(parent->Attribute("link"));
     const std::optional<int> childLink = mechanism.findLink(child->Attribute("link"));
     if (!parentLink) {
-      return reader.error("joint", name, std::string("parent '") + parent->Attribute("link") + "' is not a link");
+      return reader.error("joint", name,
+                          std::string("parent '") + parent->Attribute("link") + "' is not a link");
     }
     if (!childLink) {
-      return reader.error("joint", name, std::string("child '") + child->Attribute("link") + "' is not a link");
+      return reader.error("joint", name,
+                          std::string("child '") + child->Attribute("link") + "' is not a link");
     }
     if (*parentLink == *childLink) {
       return reader.error("joint", name, "joins link '" + mechanism.links[*childLink].name + "' to itself");
@@ -218,14 +229,15 @@ Result<Mechanism> readTree(const tinyxml2::XMLElement* robot, const LoopElementR
     static const std::set<std::string> kTreeTypes = {"revolute", "continuous", "prismatic",
                                                      "fixed",    "floating",   "planar"};
     if (kTreeTypes.count(typeText) == 0) {
-      return reader.error("joint", name,
-                          "type '" + typeText +
-                              "' is not a URDF tree type (revolute, continuous, prismatic, fixed, floating, planar)");
+      return reader.error(
+          "joint", name,
+          "type '" + typeText +
+              "' is not a URDF tree type (revolute, continuous, prismatic, fixed, floating, planar)");
     }
     if (const tinyxml2::XMLElement* origin = e->FirstChildElement("origin")) {
       for (const char* attribute : {"xyz", "rpy"}) {
-        Result<Eigen::Vector3d> v =
-            reader.parseVector(origin->Attribute(attribute), "joint", name, std::string("origin ") + attribute);
+        Result<Eigen::Vector3d> v = reader.parseVector(origin->Attribute(attribute), "joint", name,
+                                                       std::string("origin ") + attribute);
         if (!isOk(v)) {
           return diagnosticOf(v);
         }
@@ -290,13 +302,26 @@ Result<Mechanism> readTreeJointsFromUrdfdom(Mechanism mechanism, const std::stri
       return reader.error("joint", joint.name, "was not read by urdfdom");
     }
     switch (urdfJoint->type) {
-      case urdf::Joint::REVOLUTE: joint.type = JointType::Revolute; break;
-      case urdf::Joint::CONTINUOUS: joint.type = JointType::Continuous; break;
-      case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
-      case urdf::Joint::FLOATING: joint.type = JointType::Floating; break;
-      case urdf::Joint::PLANAR: joint.type = JointType::Planar; break;
-      case urdf::Joint::FIXED: joint.type = JointType::Fixed; break;
-      default: return reader.error("joint", joint.name, "has an unknown type");
+      case urdf::Joint::REVOLUTE:
+        joint.type = JointType::Revolute;
+        break;
+      case urdf::Joint::CONTINUOUS:
+        joint.type = JointType::Continuous;
+        break;
+      case urdf::Joint::PRISMATIC:
+        joint.type = JointType::Prismatic;
+        break;
+      case urdf::Joint::FLOATING:
+        joint.type = JointType::Floating;
+        break;
+      case urdf::Joint::PLANAR:
+        joint.type = JointType::Planar;
+        break;
+      case urdf::Joint::FIXED:
+        joint.type = JointType::Fixed;
+        break;
+      default:
+        return reader.error("joint", joint.name, "has an unknown type");
     }
     joint.frame1 = toIsometry(urdfJoint->parent_to_joint_origin_transform);
     joint.frame2 = Eigen::Isometry3d::Identity();
@@ -335,7 +360,8 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
   for (const Joint& joint : mechanism.joints) {
     names.insert(joint.name);
   }
-  auto readEnds = [&](const tinyxml2::XMLElement* e, const std::string& kind, Joint& joint) -> std::optional<Diagnostic> {
+  auto readEnds = [&](const tinyxml2::XMLElement* e, const std::string& kind,
+                      Joint& joint) -> std::optional<Diagnostic> {
     for (int side = 1; side <= 2; ++side) {
       Result<std::pair<int, Eigen::Isometry3d>> end =
           reader.parseEnd(e, side == 1 ? "link1" : "link2", kind, joint.name, mechanism);
@@ -346,7 +372,8 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
       (side == 1 ? joint.frame1 : joint.frame2) = valueOf(end).second;
     }
     if (joint.link1 == joint.link2) {
-      return reader.error(kind, joint.name, "joins link '" + mechanism.links[joint.link1].name + "' to itself");
+      return reader.error(kind, joint.name,
+                          "joins link '" + mechanism.links[joint.link1].name + "' to itself");
     }
     return std::nullopt;
   };
@@ -365,17 +392,21 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
   for (const tinyxml2::XMLElement* e = robot->FirstChildElement("distance_constraint"); e;
        e = e->NextSiblingElement("distance_constraint")) {
     Result<std::string> name = readName(e, "distance_constraint");
-    if (!isOk(name)) return diagnosticOf(name);
+    if (!isOk(name))
+      return diagnosticOf(name);
     Joint joint;
     joint.name = valueOf(name);
     joint.kind = ConnectionKind::DistanceConstraint;
     joint.type = JointType::Spherical;
-    if (std::optional<Diagnostic> d = readEnds(e, "distance_constraint", joint)) return *d;
+    if (std::optional<Diagnostic> d = readEnds(e, "distance_constraint", joint))
+      return *d;
     mechanism.joints.push_back(joint);
   }
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("cable"); e; e = e->NextSiblingElement("cable")) {
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("cable"); e;
+       e = e->NextSiblingElement("cable")) {
     Result<std::string> name = readName(e, "cable");
-    if (!isOk(name)) return diagnosticOf(name);
+    if (!isOk(name))
+      return diagnosticOf(name);
     Joint joint;
     joint.name = valueOf(name);
     joint.kind = ConnectionKind::Cable;
@@ -387,37 +418,46 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
     }
     joint.cableType = typeText == "active" ? CableType::Active : CableType::Passive;
     Result<double> length = reader.parseNumber(e->Attribute("length"), "cable", joint.name, "length");
-    if (!isOk(length)) return diagnosticOf(length);
+    if (!isOk(length))
+      return diagnosticOf(length);
     if (valueOf(length) <= 0.0) {
-      return reader.error("cable", joint.name, "length must be positive, got " + std::string(e->Attribute("length")));
+      return reader.error("cable", joint.name,
+                          "length must be positive, got " + std::string(e->Attribute("length")));
     }
     joint.length = valueOf(length);
-    if (std::optional<Diagnostic> d = readEnds(e, "cable", joint)) return *d;
+    if (std::optional<Diagnostic> d = readEnds(e, "cable", joint))
+      return *d;
     mechanism.joints.push_back(joint);
   }
   for (const tinyxml2::XMLElement* e = robot->FirstChildElement("loop_joint"); e;
        e = e->NextSiblingElement("loop_joint")) {
     Result<std::string> name = readName(e, "loop_joint");
-    if (!isOk(name)) return diagnosticOf(name);
+    if (!isOk(name))
+      return diagnosticOf(name);
     Joint joint;
     joint.name = valueOf(name);
     joint.kind = ConnectionKind::LoopJoint;
     Result<JointType> type = parseLoopJointType(e->Attribute("type"));
     if (!isOk(type)) {
       const char* typeText = e->Attribute("type");
-      return reader.error("loop_joint", joint.name,
-                          std::string("type '") + (typeText ? typeText : "") +
-                              "' is not one of revolute, continuous, prismatic, cylindrical, spherical, universal, fixed");
+      return reader.error(
+          "loop_joint", joint.name,
+          std::string("type '") + (typeText ? typeText : "") +
+              "' is not one of revolute, continuous, prismatic, cylindrical, spherical, universal, fixed");
     }
     joint.type = valueOf(type);
-    if (std::optional<Diagnostic> d = readEnds(e, "loop_joint", joint)) return *d;
+    if (std::optional<Diagnostic> d = readEnds(e, "loop_joint", joint))
+      return *d;
     Result<Eigen::Vector3d> axis = reader.parseAxis(e, "axis", "loop_joint", joint.name);
-    if (!isOk(axis)) return diagnosticOf(axis);
+    if (!isOk(axis))
+      return diagnosticOf(axis);
     joint.axis = valueOf(axis);
     Result<Eigen::Vector3d> axis2 = reader.parseAxis(e, "axis2", "loop_joint", joint.name);
-    if (!isOk(axis2)) return diagnosticOf(axis2);
+    if (!isOk(axis2))
+      return diagnosticOf(axis2);
     joint.axis2 = valueOf(axis2);
-    if (joint.type == JointType::Universal && joint.axis.cross(joint.axis2).norm() < tolerances::kPlanarAxis) {
+    if (joint.type == JointType::Universal &&
+        joint.axis.cross(joint.axis2).norm() < tolerances::kPlanarAxis) {
       return reader.error("loop_joint", joint.name, "universal joint axes 'axis' and 'axis2' are parallel");
     }
     mechanism.joints.push_back(joint);
@@ -435,23 +475,24 @@ Result<Mechanism> loadMechanismFromFile(const std::string& path) {
   return loadMechanismFromString(text.str(), path);
 }
 
-Result<JointPositions> makeJointPositions(const std::vector<std::string>& names, const std::vector<double>& values,
-                                          const Mechanism& mechanism) {
+Result<JointPositions> makeJointPositions(const std::vector<std::string>& names,
+                                          const std::vector<double>& values, const Mechanism& mechanism) {
   if (names.size() != values.size()) {
-    return makeDiagnostic(mechanism.file, "positions", "",
-                          std::to_string(values.size()) + " values for " + std::to_string(names.size()) +
-                              " joint_names");
+    return makeDiagnostic(
+        mechanism.file, "positions", "",
+        std::to_string(values.size()) + " values for " + std::to_string(names.size()) + " joint_names");
   }
   JointPositions positions;
   for (size_t i = 0; i < names.size(); ++i) {
     const std::optional<int> joint = mechanism.findJoint(names[i]);
     if (!joint) {
-      return makeDiagnostic(mechanism.file, "positions", names[i], "is not a joint of '" + mechanism.name + "'");
+      return makeDiagnostic(mechanism.file, "positions", names[i],
+                            "is not a joint of '" + mechanism.name + "'");
     }
     const Joint& j = mechanism.joints[*joint];
-    const bool singleValue = j.kind == ConnectionKind::TreeJoint &&
-                             (j.type == JointType::Revolute || j.type == JointType::Continuous ||
-                              j.type == JointType::Prismatic);
+    const bool singleValue =
+        j.kind == ConnectionKind::TreeJoint &&
+        (j.type == JointType::Revolute || j.type == JointType::Continuous || j.type == JointType::Prismatic);
     if (!singleValue) {
       return makeDiagnostic(mechanism.file, "positions", names[i],
                             std::string("is a ") + toString(j.kind) + " of type " + toString(j.type) +

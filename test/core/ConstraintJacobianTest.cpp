@@ -28,7 +28,8 @@ void expectJacobianMatchesFiniteDifferences(const CoordinateModel& model, unsign
   std::mt19937 random(seed);
   std::uniform_real_distribution<double> uniform(-0.3, 0.3);
   Eigen::VectorXd q = model.q0;
-  for (int i = 0; i < q.size(); ++i) q(i) += uniform(random);  // a random pose, off the constraint manifold
+  for (int i = 0; i < q.size(); ++i)
+    q(i) += uniform(random);  // a random pose, off the constraint manifold
   const Eigen::MatrixXd analytic = Eigen::MatrixXd(computeConstraintJacobian(model, q));
   const double h = 1e-6;
   Eigen::MatrixXd numeric(model.numConstraints(), model.numCoordinates());
@@ -49,28 +50,34 @@ void expectJacobianMatchesFiniteDifferences(const CoordinateModel& model, unsign
 TEST(ConstraintJacobian, MatchesFiniteDifferencesForEverySpatialEquationKind) {
   const CoordinateModel model = buildFromText(allJointKindsUrdf(), AnalysisMode::Spatial);
   std::set<EquationKind> kinds;
-  for (const ConstraintEquation& eq : model.equations) kinds.insert(eq.kind);
+  for (const ConstraintEquation& eq : model.equations)
+    kinds.insert(eq.kind);
   // Every kind the spatial table produces is present, so the check below covers each of them.
-  for (EquationKind kind : {EquationKind::LinkDistance, EquationKind::UnitNorm, EquationKind::LinkDotProduct,
-                            EquationKind::LinearCombination, EquationKind::CoincidentPoint, EquationKind::ParallelAxis,
-                            EquationKind::PointOnAxisLine, EquationKind::FixedTwist, EquationKind::AxisAngle,
-                            EquationKind::PointInPlane, EquationKind::Distance, EquationKind::FixedCoordinate}) {
+  for (EquationKind kind :
+       {EquationKind::LinkDistance, EquationKind::UnitNorm, EquationKind::LinkDotProduct,
+        EquationKind::LinearCombination, EquationKind::CoincidentPoint, EquationKind::ParallelAxis,
+        EquationKind::PointOnAxisLine, EquationKind::FixedTwist, EquationKind::AxisAngle,
+        EquationKind::PointInPlane, EquationKind::Distance, EquationKind::FixedCoordinate}) {
     EXPECT_TRUE(kinds.count(kind)) << "no equation of kind " << toString(kind);
   }
-  for (unsigned seed = 1; seed <= 5; ++seed) expectJacobianMatchesFiniteDifferences(model, seed);
+  for (unsigned seed = 1; seed <= 5; ++seed)
+    expectJacobianMatchesFiniteDifferences(model, seed);
 }
 
 TEST(ConstraintJacobian, MatchesFiniteDifferencesInThePlane) {
   const CoordinateModel model = buildFromText(planarJointKindsUrdf(), AnalysisMode::Planar);
   EXPECT_EQ(model.dim, 2);
   std::set<EquationKind> kinds;
-  for (const ConstraintEquation& eq : model.equations) kinds.insert(eq.kind);
-  for (EquationKind kind : {EquationKind::LinkDistance, EquationKind::LinearCombination, EquationKind::CoincidentPoint,
-                            EquationKind::ParallelAxis, EquationKind::PointOnAxisLine, EquationKind::FixedTwist,
-                            EquationKind::Distance, EquationKind::FixedCoordinate}) {
+  for (const ConstraintEquation& eq : model.equations)
+    kinds.insert(eq.kind);
+  for (EquationKind kind :
+       {EquationKind::LinkDistance, EquationKind::LinearCombination, EquationKind::CoincidentPoint,
+        EquationKind::ParallelAxis, EquationKind::PointOnAxisLine, EquationKind::FixedTwist,
+        EquationKind::Distance, EquationKind::FixedCoordinate}) {
     EXPECT_TRUE(kinds.count(kind)) << "no planar equation of kind " << toString(kind);
   }
-  for (unsigned seed = 1; seed <= 5; ++seed) expectJacobianMatchesFiniteDifferences(model, seed);
+  for (unsigned seed = 1; seed <= 5; ++seed)
+    expectJacobianMatchesFiniteDifferences(model, seed);
 }
 
 TEST(ConstraintJacobian, ResidualVanishesAtTheWrittenPoseOfAClosedMechanism) {
