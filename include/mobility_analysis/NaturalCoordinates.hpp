@@ -82,7 +82,6 @@ struct ConstraintEquation {
   Direction d1, d2;  ///< Combination: the body's basis directions (planar: d2 unused).
   Eigen::Vector3d coefficients = Eigen::Vector3d::Zero();  ///< Combination: c0, c1, c2.
   double value = 0.0;                                      ///< Dot, Cross, Component: the constant.
-  std::string text;  ///< Readable form, e.g. "|P(crank@j2) - P(crank@j1)|^2 = 1".
 };
 
 /// The mechanism in natural coordinates: elements, their coordinates at the assembled pose and the equations.
@@ -103,6 +102,13 @@ struct CoordinateModel {
   int numCoordinates() const { return static_cast<int>(q0.size()); }
   int numConstraints() const { return static_cast<int>(equations.size()); }
 };
+
+/**
+ * @brief The readable form of equation @p row, e.g. "|P(crank@j2) - P(crank@j1)|^2 = 1 Lc^2".
+ *
+ * Written on demand: a model of 10^6 equations only ever shows its redundant ones.
+ */
+std::string describeEquation(const CoordinateModel& model, int row);
 
 /// @return The plane normal if the mechanism is planar by the rule of DESIGN.md §2 at @p poses, else nothing.
 std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const LinkPoses& poses);

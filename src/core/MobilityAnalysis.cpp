@@ -84,8 +84,8 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
       ++jointEquations[eq.element];
     if (!ranks.redundant[r])
       continue;
-    report.redundantConstraints.push_back(
-        RedundantConstraint{r, toString(eq.source), elementName(eq), toString(eq.kind), eq.text});
+    report.redundantConstraints.push_back(RedundantConstraint{r, toString(eq.source), elementName(eq),
+                                                              toString(eq.kind), describeEquation(model, r)});
     if (eq.source == EquationSource::Joint)
       ++jointRedundant[eq.element];
     if (eq.source == EquationSource::Boundary)

@@ -279,11 +279,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
   auto directionValue = [&](const Direction& d) -> Eigen::Vector3d {
     return d.tail < 0 ? coordinates(d.head) : (coordinates(d.head) - coordinates(d.tail)).eval();
   };
-  auto directionName = [&](const Direction& d) -> std::string {
-    return d.tail < 0 ? model.elements[d.head].label
-                      : "(" + model.elements[d.head].label + " - " + model.elements[d.tail].label + ")";
-  };
-
   // 2. Body bases: p0 and the best-conditioned directions; auxiliary unit vectors where the joints give too
   // few.
   std::vector<BodyBasis> bases(mechanism.links.size());
@@ -393,11 +388,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
   }
 
   auto addEquation = [&](ConstraintEquation eq) { model.equations.push_back(std::move(eq)); };
-  auto format = [](double value) {
-    char text[32];
-    std::snprintf(text, sizeof(text), "%.6g", value);
-    return std::string(text);
-  };
 
   // 4. Rigid-link equations (links in document order): basis dot products, then linear combinations.
   for (size_t b = 0; b < mechanism.links.size(); ++b) {
@@ -417,14 +407,10 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
         if (i == j && dirs[i].tail < 0) {
           eq.kind = EquationKind::UnitNorm;
           eq.value = 1.0;
-          eq.text = directionName(dirs[i]) + "." + directionName(dirs[i]) + " = 1";
         } else if (i == j) {
           eq.kind = EquationKind::LinkDistance;
-          eq.text = "|" + model.elements[dirs[i].head].label + " - " + model.elements[dirs[i].tail].label +
-                    "|^2 = " + format(eq.value) + " Lc^2";
         } else {
           eq.kind = EquationKind::LinkDotProduct;
-          eq.text = directionName(dirs[i]) + "." + directionName(dirs[j]) + " = " + format(eq.value);
         }
         addEquation(eq);
       }
@@ -462,14 +448,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
         eq.coefficients = coefficients;
         if (planar)
           eq.coefficients.z() = 0.0;
-        std::string text = model.elements[e].label + " = ";
-        if (isPoint)
-          text += model.elements[basis.p0].label + " + ";
-        text += format(eq.coefficients.x()) + " " + directionName(basis.d1) + " + " +
-                format(eq.coefficients.y()) +
-                (planar ? " J" + directionName(basis.d1)
-                        : " " + directionName(basis.d2) + " + " + format(eq.coefficients.z()) + " d1 x d2");
-        eq.text = text + " (" + kAxisNames[k] + ")";
         addEquation(eq);
       }
     }
@@ -510,8 +488,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
             ConstraintEquation eq = base(EquationKind::CoincidentPoint, EquationForm::Component);
             eq.a = Direction{c.point1, c.point2};
             eq.component = k;
-            eq.text = model.elements[c.point1].label + " - " + model.elements[c.point2].label + " = 0 (" +
-                      kAxisNames[k] + ")";
             addEquation(eq);
           }
           break;
@@ -524,8 +500,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
             eq.a = Direction{c.axis1, -1};
             eq.b = parallel ? Direction{c.axis2, -1} : Direction{c.point2, c.point1};
             eq.component = k;
-            eq.text = "(" + directionName(eq.a) + " x " + directionName(eq.b) + ")" +
-                      (planar ? std::string("") : std::string("_") + kAxisNames[k]) + " = 0";
             addEquation(eq);
           }
           break;
@@ -585,11 +559,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
               }
             }
           }
-          eq.text = eq.form == EquationForm::Dot
-                        ? directionName(eq.a) + "." + directionName(eq.b) + " = " + format(eq.value)
-                        : "(" + directionName(eq.a) + " x " + directionName(eq.b) + ")" +
-                              (planar ? std::string("") : std::string("_") + kAxisNames[eq.component]) +
-                              " = " + format(eq.value);
           addEquation(eq);
           break;
         }
@@ -598,7 +567,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
           eq.a = Direction{c.axis1, -1};
           eq.b = Direction{c.axis2, -1};
           eq.value = joint.axis.dot(joint.axis2);
-          eq.text = directionName(eq.a) + "." + directionName(eq.b) + " = " + format(eq.value);
           addEquation(eq);
           break;
         }
@@ -607,7 +575,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
           eq.a = Direction{c.point2, c.point1};
           eq.b = Direction{c.axis1, -1};
           eq.value = 0.0;
-          eq.text = directionName(eq.a) + "." + directionName(eq.b) + " = 0";
           addEquation(eq);
           break;
         }
@@ -618,8 +585,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
           const double length =
               joint.kind == ConnectionKind::Cable ? joint.length / lc : directionValue(eq.a).norm();
           eq.value = length * length;
-          eq.text = "|" + model.elements[c.point2].label + " - " + model.elements[c.point1].label +
-                    "|^2 = " + format(eq.value) + " Lc^2";
           addEquation(eq);
           break;
         }
@@ -640,8 +605,6 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
       eq.a = Direction{element, -1};
       eq.component = k;
       eq.value = coordinates(element)[k];
-      eq.text = model.elements[element].label + "_" + kAxisNames[k] + " = " + format(eq.value) +
-                (model.elements[element].isPoint ? " Lc" : "");
       addEquation(eq);
     };
     for (int k = 0; k < dim; ++k) {
@@ -754,6 +717,51 @@ LinkPoses recoverPoses(const CoordinateModel& model, const Eigen::Ref<const Eige
     poses[b].translation() = (worldCentroid - rotation * localCentroid) * lc;
   }
   return poses;
+}
+
+std::string describeEquation(const CoordinateModel& model, int row) {
+  const ConstraintEquation& eq = model.equations[row];
+  const bool planar = model.dim == 2;
+  auto label = [&](int element) { return model.elements[element].label; };
+  auto name = [&](const Direction& d) {
+    return d.tail < 0 ? label(d.head) : "(" + label(d.head) + " - " + label(d.tail) + ")";
+  };
+  auto number = [](double value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.6g", value);
+    return std::string(text);
+  };
+  const std::string axis = std::string(" (") + kAxisNames[eq.component] + ")";
+  switch (eq.kind) {
+    case EquationKind::UnitNorm:
+      return name(eq.a) + "." + name(eq.a) + " = 1";
+    case EquationKind::LinkDistance:
+    case EquationKind::Distance:
+      return "|" + label(eq.a.head) + " - " + label(eq.a.tail) + "|^2 = " + number(eq.value) + " Lc^2";
+    case EquationKind::LinearCombination: {
+      std::string text = label(eq.target) + " = ";
+      if (eq.origin >= 0)
+        text += label(eq.origin) + " + ";
+      text += number(eq.coefficients.x()) + " " + name(eq.d1) + " + " + number(eq.coefficients.y()) +
+              (planar ? " J" + name(eq.d1)
+                      : " " + name(eq.d2) + " + " + number(eq.coefficients.z()) + " d1 x d2");
+      return text + axis;
+    }
+    case EquationKind::CoincidentPoint:
+      return label(eq.a.head) + " - " + label(eq.a.tail) + " = 0" + axis;
+    case EquationKind::FixedCoordinate:
+      return label(eq.a.head) + "_" + kAxisNames[eq.component] + " = " + number(eq.value) +
+             (model.elements[eq.a.head].isPoint ? " Lc" : "");
+    default:
+      break;
+  }
+  // The remaining kinds read as their algebraic form.
+  if (eq.form == EquationForm::Cross) {
+    return "(" + name(eq.a) + " x " + name(eq.b) + ")" +
+           (planar ? std::string("") : std::string("_") + kAxisNames[eq.component]) + " = " +
+           number(eq.value);
+  }
+  return name(eq.a) + "." + name(eq.b) + " = " + number(eq.value);
 }
 
 }  // namespace mobility_analysis

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include <Eigen/SVD>
+#include <Eigen/QR>
 
 namespace mobility_analysis {
 
@@ -57,10 +57,10 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
         if (norm > 0.0)
           Yl.row(i) /= norm;
       }
-      Eigen::BDCSVD<Eigen::MatrixXd> svd(Yl);
-      const Eigen::VectorXd& sigma = svd.singularValues();
-      const int rank = static_cast<int>((sigma.array() > tolerance * std::max(1.0, sigma(0))).count());
-      redundant[l] = rank == needed;
+      // Rank-revealing QR, the threshold relative to the largest pivot (the rows have unit norm).
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Yl);
+      qr.setThreshold(tolerance);
+      redundant[l] = static_cast<int>(qr.rank()) == needed;
     }
     for (int s : columns)
       columnOf[s] = -1;

@@ -72,9 +72,10 @@ class LocalStressFinder {
     } else {
       include(eq.element);
     }
+    // Start at the radius that sufficed last time: in a regular structure every stress needs the same one.
     std::optional<SelfStress> found;
     size_t frontBegin = 0;
-    for (int radius = 1, reached = 0; !found; radius *= 2) {
+    for (int radius = lastRadius_, reached = 0; !found; radius = radius < 4 ? radius + 1 : 2 * radius) {
       for (; reached < radius && frontBegin < ball_.size(); ++reached) {
         const size_t frontEnd = ball_.size();
         for (size_t i = frontBegin; i < frontEnd; ++i) {
@@ -86,11 +87,15 @@ class LocalStressFinder {
         frontBegin = frontEnd;
       }
       const std::vector<int> rows = collectRows(row);
-      if (rows.size() > kLocalLimit)
+      if (rows.size() > kLocalLimit) {
         break;
+      }
       found = eliminate(rows);
-      if (frontBegin == ball_.size())
+      if (found) {
+        lastRadius_ = std::min(radius, 4);  // a ring's global stress must not make every later search global
+      } else if (frontBegin == ball_.size()) {
         break;  // the whole component
+      }
     }
     for (int link : ball_)
       inBall_[link] = 0;
@@ -181,6 +186,7 @@ class LocalStressFinder {
   std::vector<int> ball_;
   std::vector<char> inBall_, jointTaken_;
   std::vector<int> columnMap_;
+  int lastRadius_ = 1;
 };
 
 }  // namespace
@@ -199,40 +205,35 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
   basis.numConstraints = m;
   basis.numCoordinates = n;
   SparseElimination elimination(n, order.columnPriority, tolerance, true);
-  std::vector<std::pair<int, std::vector<std::pair<int, double>>>> untraced;  // (row, multipliers)
-  std::vector<int> untracedSlot;
+  LocalStressFinder finder(mechanism, model, J, order, position, tolerance);
+  // A traced stress longer than this is found again locally; it follows the local stresses' size, so a
+  // mechanism whose loops are large is not re-solved stress by stress.
+  size_t traceLimit = kTraceLimit;
   const size_t progressStep = std::max<size_t>(1, order.rows.size() / 20);
   for (size_t i = 0; i < order.rows.size(); ++i) {
-    if (progress && i % progressStep == 0)
-      progress(0.8 * static_cast<double>(i) / static_cast<double>(m));
+    if (progress && i % progressStep == 0) {
+      progress(static_cast<double>(i) / static_cast<double>(m));
+    }
     const int r = order.rows[i];
     const double norm = J.row(r).norm();
-    if (!elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent)
+    if (!elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent) {
       continue;
-    std::optional<SelfStress> stress = elimination.traceDependency(r, elimination.multipliers(), kTraceLimit);
-    if (!stress) {
-      untraced.emplace_back(r, elimination.multipliers());
-      untracedSlot.push_back(static_cast<int>(basis.stresses.size()));
     }
-    basis.stresses.push_back(stress ? std::move(*stress) : SelfStress{});
+    std::optional<SelfStress> stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
+    if (!stress) {
+      stress = finder.find(r);
+      if (stress) {
+        ++basis.locallyResolved;
+        traceLimit = std::max(traceLimit, 2 * stress->size());
+      } else {
+        stress = elimination.traceDependency(r, elimination.multipliers());
+      }
+    }
+    basis.stresses.push_back(std::move(*stress));
   }
   basis.rank = elimination.rank();
   basis.smallestKeptPivot = elimination.smallestKeptPivot();
   basis.largestDroppedResidual = elimination.largestDroppedResidual();
-
-  if (!untraced.empty()) {
-    LocalStressFinder finder(mechanism, model, J, order, position, tolerance);
-    for (size_t k = 0; k < untraced.size(); ++k) {
-      if (progress)
-        progress(0.8 + 0.2 * static_cast<double>(k) / static_cast<double>(untraced.size()));
-      const auto& [row, multipliers] = untraced[k];
-      std::optional<SelfStress> local = finder.find(row);
-      if (local)
-        ++basis.locallyResolved;
-      basis.stresses[untracedSlot[k]] =
-          local ? std::move(*local) : *elimination.traceDependency(row, multipliers);
-    }
-  }
 
   // Each stress scaled to unit largest coefficient, rounding noise dropped.
   for (SelfStress& stress : basis.stresses) {

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include <console_bridge/console.h>
 #include <tinyxml2.h>
@@ -14,6 +15,9 @@
 namespace mobility_analysis {
 
 namespace {
+
+/// Link index by name: mechanisms with 10^5 links are looked up once per connection end.
+using LinkIndex = std::unordered_map<std::string, int>;
 
 /// Reads the XML once; every check names the file and the element.
 class LoopElementReader {
@@ -98,7 +102,7 @@ class LoopElementReader {
   /// Reads <link1 link=".." xyz=".." rpy=".."/> (or link2) and resolves the link.
   Result<std::pair<int, Eigen::Isometry3d>> parseEnd(const tinyxml2::XMLElement* element, const char* tag,
                                                      const std::string& kind, const std::string& name,
-                                                     const Mechanism& mechanism) const {
+                                                     const LinkIndex& links) const {
     const tinyxml2::XMLElement* end = element->FirstChildElement(tag);
     if (end == nullptr) {
       return error(kind, name, std::string("missing <") + tag + ">");
@@ -107,8 +111,8 @@ class LoopElementReader {
     if (linkName == nullptr) {
       return error(kind, name, std::string("<") + tag + "> has no link attribute");
     }
-    const std::optional<int> link = mechanism.findLink(linkName);
-    if (!link) {
+    const auto link = links.find(linkName);
+    if (link == links.end()) {
       return error(kind, name, std::string(tag) + " '" + linkName + "' is not a link");
     }
     Result<Eigen::Vector3d> xyz = parseVector(end->Attribute("xyz"), kind, name, std::string(tag) + " xyz");
@@ -126,7 +130,7 @@ class LoopElementReader {
                       Eigen::AngleAxisd(valueOf(rpy).x(), Eigen::Vector3d::UnitX()))
                          .toRotationMatrix();
     frame.translation() = valueOf(xyz);
-    return std::make_pair(*link, frame);
+    return std::make_pair(link->second, frame);
   }
 
  private:
@@ -173,17 +177,22 @@ Result<Mechanism> readTree(const tinyxml2::XMLElement* robot, const LoopElementR
   mechanism.file = file;
   const char* robotName = robot->Attribute("name");
   mechanism.name = robotName == nullptr ? "" : robotName;
+  LinkIndex index;
   for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e;
        e = e->NextSiblingElement("link")) {
     const char* name = e->Attribute("name");
     if (name == nullptr || std::string(name).empty()) {
       return reader.error("link", "", "has no name");
     }
-    if (mechanism.findLink(name)) {
+    if (!index.emplace(name, static_cast<int>(mechanism.links.size())).second) {
       return reader.error("link", name, "is defined twice");
     }
     mechanism.links.push_back(Link{name});
   }
+  auto findLink = [&](const char* name) -> std::optional<int> {
+    const auto it = index.find(name);
+    return it == index.end() ? std::nullopt : std::optional<int>(it->second);
+  };
   if (mechanism.links.empty()) {
     return reader.error("robot", mechanism.name, "has no <link>");
   }
@@ -206,8 +215,8 @@ Result<Mechanism> readTree(const tinyxml2::XMLElement* robot, const LoopElementR
     if (child == nullptr || child->Attribute("link") == nullptr) {
       return reader.error("joint", name, "has no <child link=\"...\">");
     }
-    const std::optional<int> parentLink = mechanism.findLink(parent->Attribute("link"));
-    const std::optional<int> childLink = mechanism.findLink(child->Attribute("link"));
+    const std::optional<int> parentLink = findLink(parent->Attribute("link"));
+    const std::optional<int> childLink = findLink(child->Attribute("link"));
     if (!parentLink) {
       return reader.error("joint", name,
                           std::string("parent '") + parent->Attribute("link") + "' is not a link");
@@ -272,14 +281,25 @@ Result<Mechanism> readTree(const tinyxml2::XMLElement* robot, const LoopElementR
   if (root < 0) {
     return reader.error("robot", mechanism.name, "the <joint> elements form a cycle; there is no root link");
   }
+  // Walk each link up until a link known to reach the root: every link is walked once (a chain of 10^5 links
+  // would otherwise cost 10^10 steps).
+  enum : char { kUnknown, kOnPath, kReachesRoot };
+  std::vector<char> state(mechanism.links.size(), kUnknown);
+  state[root] = kReachesRoot;
+  std::vector<int> path;
   for (size_t i = 0; i < mechanism.links.size(); ++i) {
+    path.clear();
     int link = static_cast<int>(i);
-    for (size_t steps = 0; link != root; ++steps) {
-      if (steps > mechanism.links.size()) {
-        return reader.error("link", mechanism.links[i].name, "is on a cycle of <joint> elements");
-      }
+    while (state[link] == kUnknown) {
+      state[link] = kOnPath;
+      path.push_back(link);
       link = parentOf[link];
     }
+    if (state[link] == kOnPath) {
+      return reader.error("link", mechanism.links[i].name, "is on a cycle of <joint> elements");
+    }
+    for (int l : path)
+      state[l] = kReachesRoot;
   }
   mechanism.rootLink = root;
   return mechanism;
@@ -355,6 +375,9 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
     return withTree;
   }
   Mechanism mechanism = valueOf(std::move(withTree));
+  LinkIndex links;
+  for (size_t l = 0; l < mechanism.links.size(); ++l)
+    links.emplace(mechanism.links[l].name, static_cast<int>(l));
 
   std::set<std::string> names;
   for (const Joint& joint : mechanism.joints) {
@@ -364,7 +387,7 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
                       Joint& joint) -> std::optional<Diagnostic> {
     for (int side = 1; side <= 2; ++side) {
       Result<std::pair<int, Eigen::Isometry3d>> end =
-          reader.parseEnd(e, side == 1 ? "link1" : "link2", kind, joint.name, mechanism);
+          reader.parseEnd(e, side == 1 ? "link1" : "link2", kind, joint.name, links);
       if (!isOk(end)) {
         return diagnosticOf(end);
       }
