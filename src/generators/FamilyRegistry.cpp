@@ -65,7 +65,10 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"door", 0, 1, "door [K=3]",
        "door on K coaxial hinges; spatial DOF 1 G 6-5K R 5K-5, planar G 3-2K R 2K-2"},
       {"sle_planar", 1, 1, "sle_planar N", "planar scissor mast, pin + slider base; planar DOF 1 G 1 R 0"},
-      {"sle_spatial", 1, 1, "sle_spatial N", "triangular scissor mast; spatial DOF 1 G 3-6N R 6N-2"},
+      {"sle_spatial", 1, 1, "sle_spatial N",
+       "scissor mast, pin + slider base, for --mode spatial; spatial DOF 1 G 1-3N R 3N"},
+      {"sle_triangular", 1, 1, "sle_triangular N",
+       "triangular-prism scissor mast, spherical face pins; spatial DOF 1 G 3-6N R 6N-2"},
       {"hoberman", 1, 1, "hoberman N (N >= 3)", "Hoberman-type ring; planar DOF 1 G -3 R 4"},
       {"parallelogram_grid", 2, 2, "parallelogram_grid R C",
        "R x C grid of continuous bars; planar DOF 1 G R+C+1-2RC R 2RC-R-C"},
@@ -168,6 +171,8 @@ GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& r
     mechanism = makeSlePlanarMast(n.at(0));
   } else if (family == "sle_spatial") {
     mechanism = makeSleSpatialMast(n.at(0));
+  } else if (family == "sle_triangular") {
+    mechanism = makeSleTriangularMast(n.at(0));
   } else if (family == "hoberman") {
     if (n.at(0) < 3) {
       return GeneratorError{

@@ -83,10 +83,30 @@ MechanismDescription makeSlePlanarMast(int units) {
 
 // ---------------------------------------------------------------------------------------------------------
 std::vector<FamilyExpectation> expectSleSpatialMast(int units) {
-  return {expectation("spatial", 1, 3 - 6 * units)};
+  return {expectation("spatial", 1, 1 - 3 * units)};
 }
 
 MechanismDescription makeSleSpatialMast(int units) {
+  MechanismDescription m = makeSlePlanarMast(units);
+  m.name = "sle_spatial_" + std::to_string(units);
+  m.comment =
+      "Scissor (SLE) mast of " + std::to_string(units) +
+      " units on a pin + slider base, for analysis in space (mode spatial):\n"
+      "the geometry of sle_planar (all hinge axes along z, so auto mode would pick the plane). In space\n"
+      "each unit's scissor loop is over-constrained by the 3 out-of-plane equations of a planar loop.\n"
+      "Closed form (N units): links 2N + 2, joints 3N + 1; spatial DOF 1, Gruebler 6(2N+2 - 3N-1 - 1) + 3N+1\n"
+      "= 1 - 3N, redundant 3N.\n" +
+      m.comment.substr(m.comment.find("Unit k:"));
+  m.expectations = expectSleSpatialMast(units);
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+std::vector<FamilyExpectation> expectSleTriangularMast(int units) {
+  return {expectation("spatial", 1, 3 - 6 * units)};
+}
+
+MechanismDescription makeSleTriangularMast(int units) {
   const double barLength = 1.0;
   const double elevation = 50 * kDeg;
   const double w = barLength * std::cos(elevation);
@@ -111,7 +131,7 @@ MechanismDescription makeSleSpatialMast(int units) {
   };
 
   MechanismDescription m;
-  m.name = "sle_spatial_" + std::to_string(units);
+  m.name = "sle_triangular_" + std::to_string(units);
   m.comment =
       "Spatial scissor mast of " + std::to_string(units) +
       " units: right prism on an equilateral triangle (side w = cos 50 m, centred on the z axis).\n"
@@ -171,7 +191,7 @@ MechanismDescription makeSleSpatialMast(int units) {
   }
   addCorners(units);
   m.visualRadius = 0.015;
-  m.expectations = expectSleSpatialMast(units);
+  m.expectations = expectSleTriangularMast(units);
   return m;
 }
 

@@ -74,7 +74,7 @@ TEST(RedundantLinks, EqualTheDefinitionOnTheGeneratedFamilies) {
       expectSameAsRemoval(generated(makeParallelogramGrid(n, n + 1)), mode, "grid");
     }
     expectSameAsRemoval(generated(makeDoor(n + 1)), AnalysisMode::Spatial, "door");
-    expectSameAsRemoval(generated(makeSleSpatialMast(n)), AnalysisMode::Spatial, "sle_spatial");
+    expectSameAsRemoval(generated(makeSleTriangularMast(n)), AnalysisMode::Spatial, "sle_triangular");
   }
 }
 

@@ -30,6 +30,8 @@ std::vector<Family> families() {
                     [n] { return expectDoor(n + 1); }});
   }
   for (int n : {1, 2, 4}) {
+    list.push_back({"sle_triangular_" + std::to_string(n), [n] { return makeSleTriangularMast(n); },
+                    [n] { return expectSleTriangularMast(n); }});
     list.push_back({"sle_spatial_" + std::to_string(n), [n] { return makeSleSpatialMast(n); },
                     [n] { return expectSleSpatialMast(n); }});
     list.push_back({"grid_" + std::to_string(n) + "x" + std::to_string(n + 1),

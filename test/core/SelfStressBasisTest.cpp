@@ -167,7 +167,7 @@ TEST(SelfStressBasis, EqualsContractOrderAndDenseOnTheGeneratedFamilies) {
     checkModel(buildModel(generated(makeDoor(n + 1)), AnalysisMode::Spatial), "door spatial", true);
   }
   for (int n : {1, 2, 4}) {
-    checkModel(buildModel(generated(makeSleSpatialMast(n)), AnalysisMode::Spatial), "sle_spatial", n <= 2);
+    checkModel(buildModel(generated(makeSleTriangularMast(n)), AnalysisMode::Spatial), "sle_triangular", n <= 2);
     checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Planar), "grid planar",
                true);
     checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Spatial), "grid spatial",

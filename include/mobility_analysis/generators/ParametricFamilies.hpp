@@ -25,13 +25,31 @@ std::vector<FamilyExpectation> expectSlePlanarMast(int units);
 MechanismDescription makeSlePlanarMast(int units);
 
 /**
- * @brief Closed-form expectations of the triangular scissor mast (makeSleSpatialMast()).
+ * @brief Closed-form expectations of the scissor mast analysed in space (makeSleSpatialMast()).
+ *
+ * Links 2N + 2, joints 3N + 1 revolute/prismatic: spatial (λ 6) DOF 1, Grübler 1 − 3N, redundant 3N.
+ */
+std::vector<FamilyExpectation> expectSleSpatialMast(int units);
+
+/**
+ * @brief The scissor (SLE) mast on a pin + slider base of makeSlePlanarMast(), named and described for analysis
+ *        in space (`--mode spatial`; auto mode picks the plane, every hinge axis being parallel).
+ *
+ * What a real mast is: hinges in three-dimensional space, each unit's scissor loop over-constrained by the three
+ * out-of-plane equations of a planar loop, yet the mast deploys with one freedom.
+ * @param[in] units N ≥ 1.
+ * @note Expectations: see expectSleSpatialMast().
+ */
+MechanismDescription makeSleSpatialMast(int units);
+
+/**
+ * @brief Closed-form expectations of the triangular scissor mast (makeSleTriangularMast()).
  *
  * Links 6N (6 bars per unit, one of them the ground), joints 12N − 3: 3N centre revolutes and 9N − 3
  * spherical joints (6(N − 1) face pins, 3(N + 1) corner joints); Σ F = 30N − 9.
  * spatial (λ 6): DOF 1, Grübler 6(6N − (12N − 3) − 1) + 30N − 9 = 3 − 6N, redundant 6N − 2.
  */
-std::vector<FamilyExpectation> expectSleSpatialMast(int units);
+std::vector<FamilyExpectation> expectSleTriangularMast(int units);
 
 /**
  * @brief Spatial scissor mast: a right prism on an equilateral triangle whose three faces are scissor chains
@@ -47,9 +65,9 @@ std::vector<FamilyExpectation> expectSleSpatialMast(int units);
  * links and 12 joints (3 R + 9 S, 42 joint equations); verified numerically (Jacobian nullity 1, finite
  * motion).
  * @param[in] units N ≥ 1.
- * @note Expectations: see expectSleSpatialMast().
+ * @note Expectations: see expectSleTriangularMast().
  */
-MechanismDescription makeSleSpatialMast(int units);
+MechanismDescription makeSleTriangularMast(int units);
 
 /**
  * @brief Closed-form expectations of the Hoberman-type ring with @p units angulated units (N ≥ 3).
