@@ -19,7 +19,8 @@ struct EliminationOrder {
 };
 
 /**
- * @brief Sweeps the mechanism breadth-first from the ground over every connection, tree or loop.
+ * @brief Sweeps the mechanism from the ground over every connection with equations, tree or loop, by maximum
+ *        cardinality search: the next link is the one with the most neighbours already swept.
  *
  * A link's rigid-link equations are taken when the sweep reaches it (the ground's boundary equations right
  * after its own), a connection's equations when the sweep has reached both its links, and coordinates are

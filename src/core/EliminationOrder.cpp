@@ -1,7 +1,8 @@
 #include "mobility_analysis/EliminationOrder.hpp"
 
 #include <algorithm>
-#include <deque>
+#include <queue>
+#include <tuple>
 
 namespace mobility_analysis {
 
@@ -41,30 +42,40 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
     incident[joint.link2].push_back(j);
   }
 
-  // Breadth-first discovery from the ground (then any other component, so every equation is placed).
-  std::vector<int> discovered(numLinks, -1), sweep;
+  // Maximum cardinality search from the ground: the next link is the one with the most links already swept
+  // among its neighbours (ties: the one touched first, so the sweep advances like a front). A link reached
+  // this way closes every loop it can right away, which keeps the front narrow and, with the attachment rule
+  // below, puts each loop's closing connection where no later loop passes.
+  std::vector<int> discovered(numLinks, -1), sweptNeighbours(numLinks, 0), touched(numLinks, -1), sweep;
   sweep.reserve(numLinks);
-  std::deque<int> queue;
+  using Candidate = std::tuple<int, int, int>;  // (swept neighbours, -touch time, link)
+  std::priority_queue<Candidate> candidates;
+  int touchClock = 0;
+  auto sweepLink = [&](int link) {
+    discovered[link] = static_cast<int>(sweep.size());
+    sweep.push_back(link);
+    for (int j : incident[link]) {
+      const int other = otherEnd(j, link);
+      if (discovered[other] >= 0)
+        continue;
+      if (touched[other] < 0)
+        touched[other] = touchClock++;
+      candidates.emplace(++sweptNeighbours[other], -touched[other], other);
+    }
+  };
   std::vector<int> starts = {mechanism.rootLink};
   for (int l = 0; l < numLinks; ++l)
     starts.push_back(l);
   for (int start : starts) {
     if (discovered[start] >= 0)
       continue;
-    discovered[start] = static_cast<int>(sweep.size());
-    sweep.push_back(start);
-    queue.push_back(start);
-    while (!queue.empty()) {
-      const int link = queue.front();
-      queue.pop_front();
-      for (int j : incident[link]) {
-        const int other = otherEnd(j, link);
-        if (discovered[other] < 0) {
-          discovered[other] = static_cast<int>(sweep.size());
-          sweep.push_back(other);
-          queue.push_back(other);
-        }
-      }
+    sweepLink(start);
+    while (!candidates.empty()) {
+      const auto [count, touch, link] = candidates.top();
+      candidates.pop();
+      if (discovered[link] >= 0 || count != sweptNeighbours[link])
+        continue;  // stale entry
+      sweepLink(link);
     }
   }
 

@@ -50,8 +50,8 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
     if (isOk(model)) {
       served_ = valueOf(std::move(model));
       const MobilityReport& r = served_->analysis.report;
-      ROS_INFO("Serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations", r.robot.c_str(), r.mode.c_str(),
-               r.dof, r.grublerKutzbachDof, r.numRedundant);
+      ROS_INFO("Serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations", r.robot.c_str(),
+               r.mode.c_str(), r.dof, r.grublerKutzbachDof, r.numRedundant);
       publish();
     } else {
       loadError_ = diagnosticOf(model).toString();
@@ -60,7 +60,8 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
   }
 
   getDofServer_ = privateNodeHandle_.advertiseService("get_dof", &MobilityServer::getDof, this);
-  getRedundancyServer_ = privateNodeHandle_.advertiseService("get_redundancy", &MobilityServer::getRedundancy, this);
+  getRedundancyServer_ =
+      privateNodeHandle_.advertiseService("get_redundancy", &MobilityServer::getRedundancy, this);
   loadRobotServer_ = privateNodeHandle_.advertiseService("load_robot", &MobilityServer::loadRobot, this);
 }
 
@@ -83,8 +84,10 @@ bool MobilityServer::readParameters() {
     XmlRpc::XmlRpcValue value;
     privateNodeHandle_.getParam("rank_tolerance", value);
     double tolerance = std::nan("");
-    if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble) tolerance = static_cast<double>(value);
-    if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) tolerance = static_cast<int>(value);
+    if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble)
+      tolerance = static_cast<double>(value);
+    if (value.getType() == XmlRpc::XmlRpcValue::TypeInt)
+      tolerance = static_cast<int>(value);
     if (!(tolerance > 0.0 && tolerance < 1.0)) {
       ROS_FATAL("Parameter '%s' = %s is not a number in (0, 1) (a relative rank threshold, default 1e-8)",
                 privateNodeHandle_.resolveName("rank_tolerance").c_str(), value.toXml().c_str());
@@ -93,7 +96,8 @@ bool MobilityServer::readParameters() {
     rankTolerance_ = tolerance;
   }
 
-  if (privateNodeHandle_.hasParam("fixed_frame") && !privateNodeHandle_.getParam("fixed_frame", fixedFrame_)) {
+  if (privateNodeHandle_.hasParam("fixed_frame") &&
+      !privateNodeHandle_.getParam("fixed_frame", fixedFrame_)) {
     ROS_FATAL("Parameter '%s' must be a string (a tf frame id, or empty)",
               privateNodeHandle_.resolveName("fixed_frame").c_str());
     return false;
@@ -120,22 +124,35 @@ AnalysisOptions MobilityServer::makeOptions(AnalysisMode mode, const JointPositi
 Result<MobilityServer::ServedModel> MobilityServer::analyseDescription(const std::string& urdfText,
                                                                        const std::string& source,
                                                                        AnalysisMode mode) const {
+  const auto start = std::chrono::steady_clock::now();
   Result<Mechanism> mechanism = loadMechanismFromString(urdfText, source);
-  if (!isOk(mechanism)) return diagnosticOf(mechanism);
+  if (!isOk(mechanism))
+    return diagnosticOf(mechanism);
+  const double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (loadSeconds > kProgressQuietTime) {
+    ROS_INFO("analysis: loaded %zu links and %zu connections (%.1f s)", valueOf(mechanism).links.size(),
+             valueOf(mechanism).joints.size(), loadSeconds);
+  }
   Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), makeOptions(mode, {}));
-  if (!isOk(analysis)) return diagnosticOf(analysis);
+  if (!isOk(analysis))
+    return diagnosticOf(analysis);
   return ServedModel{valueOf(std::move(mechanism)), valueOf(std::move(analysis))};
 }
 
 template <class Request>
 Result<MobilityReport> MobilityServer::reportFor(const Request& request) const {
-  if (!served_) return makeDiagnostic("", "robot_description", "", "no model loaded: " + loadError_);
+  if (!served_)
+    return makeDiagnostic("", "robot_description", "", "no model loaded: " + loadError_);
   const Result<JointPositions> positions = fromRequest(request, served_->mechanism);
-  if (!isOk(positions)) return diagnosticOf(positions);
-  if (valueOf(positions).empty()) return served_->analysis.report;
+  if (!isOk(positions))
+    return diagnosticOf(positions);
+  if (valueOf(positions).empty())
+    return served_->analysis.report;
   // A pose of the caller's: analysed aside, the served model is not changed.
-  Result<MobilityAnalysis> analysis = analyzeMechanism(served_->mechanism, makeOptions(mode_, valueOf(positions)));
-  if (!isOk(analysis)) return diagnosticOf(analysis);
+  Result<MobilityAnalysis> analysis =
+      analyzeMechanism(served_->mechanism, makeOptions(mode_, valueOf(positions)));
+  if (!isOk(analysis))
+    return diagnosticOf(analysis);
   return valueOf(std::move(analysis)).report;
 }
 
@@ -166,7 +183,8 @@ bool MobilityServer::getRedundancy(GetRedundancy::Request& request, GetRedundanc
 bool MobilityServer::loadRobot(LoadRobot::Request& request, LoadRobot::Response& response) {
   return guarded("load_robot", response, [&] {
     const Result<ServedModel> model = [&]() -> Result<ServedModel> {
-      if (request.mode.empty()) return analyseDescription(request.urdf, "load_robot", mode_);
+      if (request.mode.empty())
+        return analyseDescription(request.urdf, "load_robot", mode_);
       const Result<AnalysisMode> mode = parseAnalysisMode(request.mode);
       if (!isOk(mode)) {
         return makeDiagnostic("load_robot", "request", "mode",
@@ -179,23 +197,26 @@ bool MobilityServer::loadRobot(LoadRobot::Request& request, LoadRobot::Response&
       loadError_.clear();
       const MobilityReport& r = served_->analysis.report;
       toResponse(r, response);
-      ROS_INFO("load_robot: now serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations", r.robot.c_str(),
-               r.mode.c_str(), r.dof, r.grublerKutzbachDof, r.numRedundant);
+      ROS_INFO("load_robot: now serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations",
+               r.robot.c_str(), r.mode.c_str(), r.dof, r.grublerKutzbachDof, r.numRedundant);
       publish();
       return;
     }
-    if (served_) toResponse(served_->analysis.report, response);  // Says what is still served.
+    if (served_)
+      toResponse(served_->analysis.report, response);  // Says what is still served.
     toFailure(diagnosticOf(model), response);
     ROS_WARN("load_robot: %s (the previous model stays loaded)", diagnosticOf(model).toString().c_str());
   });
 }
 
 void MobilityServer::publish() {
-  if (!served_) return;
+  if (!served_)
+    return;
   const Mechanism& mechanism = served_->mechanism;
   const LinkPoses& poses = served_->analysis.assembled.poses;
   markerPublisher_.publish(toMarkerArray(mechanism, poses, served_->analysis.report));
-  // A fresh broadcaster so the latched /tf_static holds only this model's frames, not the previous model's too.
+  // A fresh broadcaster so the latched /tf_static holds only this model's frames, not the previous model's
+  // too.
   tfBroadcaster_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
   tfBroadcaster_->sendTransform(toTransforms(mechanism, poses, fixedFrame_, ros::Time::now()));
 }

@@ -1,5 +1,6 @@
-/// mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] [--rank-tolerance T] [--json]
-/// Prints the mobility report of a closed-loop URDF; on bad input one line on stderr and exit code 2.
+/// mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] [--rank-tolerance T]
+/// [--json] Prints the mobility report of a closed-loop URDF; on bad input one line on stderr and exit
+/// code 2.
 
 #include <chrono>
 #include <cstdlib>
@@ -33,7 +34,8 @@ int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
       auto next = [&](const std::string& option) -> const char* {
-        if (i + 1 >= argc) return nullptr;
+        if (i + 1 >= argc)
+          return nullptr;
         (void)option;
         return argv[++i];
       };
@@ -41,14 +43,18 @@ int main(int argc, char** argv) {
         json = true;
       } else if (arg == "--mode" || arg == "--positions" || arg == "--rank-tolerance") {
         const char* value = next(arg);
-        if (value == nullptr) return fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage);
-        if (arg == "--mode") modeText = value;
-        if (arg == "--positions") positionsText = value;
+        if (value == nullptr)
+          return fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage);
+        if (arg == "--mode")
+          modeText = value;
+        if (arg == "--positions")
+          positionsText = value;
         if (arg == "--rank-tolerance") {
           char* end = nullptr;
           rankTolerance = std::strtod(value, &end);
           if (*end != '\0' || !(rankTolerance > 0.0 && rankTolerance < 1.0)) {
-            return fail(std::string("mobility_report: --rank-tolerance '") + value + "' is not a number in (0, 1)");
+            return fail(std::string("mobility_report: --rank-tolerance '") + value +
+                        "' is not a number in (0, 1)");
           }
         }
       } else if (arg == "-h" || arg == "--help") {
@@ -62,32 +68,43 @@ int main(int argc, char** argv) {
         return fail("mobility_report: more than one file given ('" + file + "', '" + arg + "'); " + kUsage);
       }
     }
-    if (file.empty()) return fail(std::string("mobility_report: no URDF file given; ") + kUsage);
+    if (file.empty())
+      return fail(std::string("mobility_report: no URDF file given; ") + kUsage);
 
     const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
-    if (!isOk(mode)) return fail("mobility_report: --mode '" + modeText + "' is not one of auto, planar, spatial");
+    if (!isOk(mode))
+      return fail("mobility_report: --mode '" + modeText + "' is not one of auto, planar, spatial");
+    // Long runs say where they are on stderr (stdout stays the report alone), the loading included.
+    const auto start = std::chrono::steady_clock::now();
+    auto elapsed = [start] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
     const Result<Mechanism> mechanism = loadMechanismFromFile(file);
-    if (!isOk(mechanism)) return fail(diagnosticOf(mechanism).toString());
+    if (!isOk(mechanism))
+      return fail(diagnosticOf(mechanism).toString());
+    if (elapsed() > 1.0) {
+      std::cerr << "mobility_report: loaded " << valueOf(mechanism).links.size() << " links and "
+                << valueOf(mechanism).joints.size() << " connections (" << elapsed() << " s)" << std::endl;
+    }
     AnalysisOptions options;
     options.mode = valueOf(mode);
     options.rankTolerance = rankTolerance;
     if (!positionsText.empty()) {
       const Result<JointPositions> positions = parseJointPositions(positionsText, valueOf(mechanism));
-      if (!isOk(positions)) return fail(diagnosticOf(positions).toString());
+      if (!isOk(positions))
+        return fail(diagnosticOf(positions).toString());
       options.positions = valueOf(positions);
     }
-    // Long analyses say where they are on stderr; stdout stays the report alone.
-    options.progress = [start = std::chrono::steady_clock::now(), last = -1.0](const std::string& phase,
-                                                                               double fraction) mutable {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (elapsed > 1.0 && fraction - last >= 0.1) {
-        std::cerr << "mobility_report: " << phase << " " << static_cast<int>(100 * fraction) << "% (" << elapsed
-                  << " s)" << std::endl;
+    options.progress = [elapsed, last = -1.0](const std::string& phase, double fraction) mutable {
+      if (elapsed() > 1.0 && fraction - last >= 0.1) {
+        std::cerr << "mobility_report: " << phase << " " << static_cast<int>(100 * fraction) << "% ("
+                  << elapsed() << " s)" << std::endl;
         last = fraction;
       }
     };
     const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
-    if (!isOk(analysis)) return fail(diagnosticOf(analysis).toString());
+    if (!isOk(analysis))
+      return fail(diagnosticOf(analysis).toString());
     std::cout << (json ? toJson(valueOf(analysis).report) : toText(valueOf(analysis).report));
     return 0;
   } catch (const std::exception& e) {
