@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/RandomMatrices.hpp"
 #include "core/TestModels.hpp"
 
 using namespace mobility_analysis;
@@ -46,21 +47,9 @@ TEST(RedundancyAnalysis, DependencyLeavesOutRowsWithZeroCoefficient) {
 
 TEST(RedundancyAnalysis, SparseEliminationEqualsDenseGramSchmidtOnRandomRankDeficientMatrices) {
   std::mt19937 random(7);
-  std::uniform_int_distribution<int> pick(0, 9);
-  std::normal_distribution<double> normal;
   for (int trial = 0; trial < 40; ++trial) {
     const int n = 12, m = 18;
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m, n);
-    for (int r = 0; r < m; ++r) {
-      if (r >= 6 && pick(random) < 5) {
-        // A combination of two earlier rows: structurally sparse, numerically exact dependency.
-        const int a = pick(random) % r, b = (pick(random) + 3) % r;
-        J.row(r) = normal(random) * J.row(a) + normal(random) * J.row(b);
-      } else {
-        for (int k = 0; k < 3; ++k)
-          J(r, (r + 4 * k + pick(random)) % n) = normal(random);
-      }
-    }
+    const Eigen::MatrixXd J = makeRankDeficientMatrix(random, m, n, 6);
     const OrderedRank sparse = computeOrderedRank(toSparse(J), 1e-9);
     const OrderedRank dense = computeOrderedRankDense(J, 1e-9);
     EXPECT_EQ(sparse.redundant, dense.redundant) << "trial " << trial;

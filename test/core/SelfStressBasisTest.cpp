@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/RandomMatrices.hpp"
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
@@ -97,20 +98,9 @@ void checkModel(const Model& m, const std::string& name, bool dense) {
 TEST(SelfStressBasis, OrderedRankFromAnyBasisEqualsTheDenseReferenceOnRandomMatrices) {
   // The echelon argument does not depend on where the basis came from: find one in a random row order.
   std::mt19937 random(11);
-  std::uniform_int_distribution<int> pick(0, 9);
-  std::normal_distribution<double> normal;
   for (int trial = 0; trial < 40; ++trial) {
     const int n = 12, m = 20;
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m, n);
-    for (int r = 0; r < m; ++r) {
-      if (r >= 4 && pick(random) < 5) {
-        const int a = pick(random) % r, b = (pick(random) + 3) % r;
-        J.row(r) = normal(random) * J.row(a) + normal(random) * J.row(b);
-      } else {
-        for (int k = 0; k < 3; ++k)
-          J(r, (r + 4 * k + pick(random)) % n) = normal(random);
-      }
-    }
+    const Eigen::MatrixXd J = makeRankDeficientMatrix(random, m, n, 4);
     const SparseJacobian sparse = J.sparseView();
     EliminationOptions options;
     options.rowOrder.resize(m);
