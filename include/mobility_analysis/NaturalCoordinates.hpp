@@ -49,6 +49,7 @@ enum class EquationForm {
   Component,    ///< a_component - value
   Combination,  ///< (x_target - x_origin - c0 d1 - c1 d2 - c2 d1 x d2)_component; planar: d2 := J d1, no c2
                 ///< term
+  Triple,       ///< (a x b).c - value (space only)
 };
 
 /// What an equation means, for names and for tests.
@@ -76,7 +77,8 @@ struct ConstraintEquation {
   EquationKind kind = EquationKind::LinkDistance;
   EquationForm form = EquationForm::Dot;
   int component = 0;
-  Direction a, b;    ///< Operands (Dot, Cross: a and b; Component: a).
+  Direction a, b;    ///< Operands (Dot, Cross: a and b; Component: a; Triple: a, b and c).
+  Direction c;       ///< Triple: the third operand.
   int target = -1;   ///< Combination: the element expressed.
   int origin = -1;   ///< Combination: the body's base point (points only), else -1.
   Direction d1, d2;  ///< Combination: the body's basis directions (planar: d2 unused).

@@ -75,6 +75,10 @@ const char* toString(EquationKind kind) {
 
 namespace {
 
+/// A twist equation whose rate under the turn is below this (relative to its operands' lengths) does not see
+/// the turn; the triple-product form is used instead [-].
+constexpr double kDegenerateTwistRate = 1e-6;
+
 const char kAxisNames[] = {'x', 'y', 'z'};
 
 /// Joint axis (and universal second axis) of a connection in the world frame.
@@ -559,6 +563,35 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
               }
             }
           }
+          // When every direction of both bodies lies in one plane with the axis (links that only carry
+          // sliders along their plane, analysed in space), no pair sees the turn: the normal of one body's
+          // two directions does, as the triple product (a x b).c with the other body's direction c.
+          if (!planar && best < kDegenerateTwistRate && dirsA.size() == 2 && dirsB.size() == 2) {
+            auto consider = [&](const Direction& a, const Direction& b, const Direction& c,
+                                const Eigen::Vector3d& va, const Eigen::Vector3d& vb,
+                                const Eigen::Vector3d& vc, bool pairTurns) {
+              const Eigen::Vector3d normal = va.cross(vb);
+              const double scale = va.norm() * vb.norm() * vc.norm();
+              // The turning body's vectors move by n x v: the pair's normal by n x normal, or c by n x c.
+              const double rate =
+                  std::abs(pairTurns ? n.cross(normal).dot(vc) : normal.dot(n.cross(vc))) / scale;
+              if (rate > best * (1.0 + 1e-9)) {
+                best = rate;
+                eq.form = EquationForm::Triple;
+                eq.a = a;
+                eq.b = b;
+                eq.c = c;
+                eq.value = normal.dot(vc);
+              }
+            };
+            const Eigen::Vector3d a1 = directionValue(dirsA[0]), a2 = directionValue(dirsA[1]);
+            const Eigen::Vector3d b1 = project(aligned * worldOf(dirsB[0]));
+            const Eigen::Vector3d b2 = project(aligned * worldOf(dirsB[1]));
+            for (int i = 0; i < 2; ++i) {
+              consider(dirsA[0], dirsA[1], dirsB[i], a1, a2, i == 0 ? b1 : b2, false);
+              consider(dirsB[0], dirsB[1], dirsA[i], b1, b2, i == 0 ? a1 : a2, true);
+            }
+          }
           addEquation(eq);
           break;
         }
@@ -756,6 +789,9 @@ std::string describeEquation(const CoordinateModel& model, int row) {
       break;
   }
   // The remaining kinds read as their algebraic form.
+  if (eq.form == EquationForm::Triple) {
+    return "(" + name(eq.a) + " x " + name(eq.b) + ")." + name(eq.c) + " = " + number(eq.value);
+  }
   if (eq.form == EquationForm::Cross) {
     return "(" + name(eq.a) + " x " + name(eq.b) + ")" +
            (planar ? std::string("") : std::string("_") + kAxisNames[eq.component]) + " = " +

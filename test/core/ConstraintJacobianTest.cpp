@@ -80,6 +80,27 @@ TEST(ConstraintJacobian, MatchesFiniteDifferencesInThePlane) {
     expectJacobianMatchesFiniteDifferences(model, seed);
 }
 
+TEST(ConstraintJacobian, MatchesFiniteDifferencesForTheTripleProductTwist) {
+  // Three sliders analysed in space: every direction of every link lies in the plane of the slide axes, so no
+  // pair of directions sees the twist of slide_ab; a triple product (the normal of one link's directions . a
+  // direction of the other) does. (The other slides find a parallel pair, whose cross product sees it.)
+  const Mechanism mechanism = loadOrFail(urdfPath("three_sliders.urdf"));
+  const LinkPoses poses = computeTreePoses(mechanism, {});
+  const Result<CoordinateModel> model = buildCoordinateModel(mechanism, poses, AnalysisMode::Spatial,
+                                                             computeCharacteristicLength(mechanism, poses));
+  ASSERT_TRUE(isOk(model));
+  int triples = 0;
+  for (const ConstraintEquation& eq : valueOf(model).equations) {
+    if (eq.form == EquationForm::Triple) {
+      ++triples;
+      EXPECT_EQ(eq.kind, EquationKind::FixedTwist);
+    }
+  }
+  EXPECT_EQ(triples, 1);
+  for (unsigned seed = 1; seed <= 5; ++seed)
+    expectJacobianMatchesFiniteDifferences(valueOf(model), seed);
+}
+
 TEST(ConstraintJacobian, ResidualVanishesAtTheWrittenPoseOfAClosedMechanism) {
   const Mechanism mechanism = loadOrFail(fixturePath("four_bar_closed.urdf"));
   const LinkPoses poses = computeTreePoses(mechanism, {});
