@@ -91,10 +91,24 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
   order.columnPriority.assign(model.numCoordinates(), 0);
   int nextColumn = 0;
   std::vector<int> closing;
+  // Within a link, the elements its rigid-link equations express (p = p0 + a d1 + b d2 + c d1 x d2) come
+  // before its basis: each such equation then pivots on its own element, and the link's other equations and
+  // its joints reduce onto the basis alone. With the basis first, the equations would pivot on it one after
+  // the other and couple every element of the link (quadratic for a door on many hinges or a bar through many
+  // pins).
+  std::vector<char> expressed(model.elements.size(), 0);
+  for (const ConstraintEquation& eq : model.equations) {
+    if (eq.form == EquationForm::Combination)
+      expressed[eq.target] = 1;
+  }
   for (int link : sweep) {
-    for (int e : model.bodyElements[link]) {
-      for (int i = 0; i < model.dim; ++i)
-        order.columnPriority[model.elements[e].offset + i] = nextColumn++;
+    for (const char wanted : {1, 0}) {
+      for (int e : model.bodyElements[link]) {
+        if (expressed[e] != wanted)
+          continue;
+        for (int i = 0; i < model.dim; ++i)
+          order.columnPriority[model.elements[e].offset + i] = nextColumn++;
+      }
     }
     order.rows.insert(order.rows.end(), linkRows[link].begin(), linkRows[link].end());
     order.rows.insert(order.rows.end(), boundaryRows[link].begin(), boundaryRows[link].end());

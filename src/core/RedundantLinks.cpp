@@ -1,8 +1,7 @@
 #include "mobility_analysis/RedundantLinks.hpp"
 
 #include <algorithm>
-
-#include <Eigen/QR>
+#include <numeric>
 
 namespace mobility_analysis {
 
@@ -48,19 +47,24 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
     }
     const int needed = k - model.lambda;
     if (static_cast<int>(columns.size()) >= needed) {
-      // Y_l with unit rows: the rank does not depend on how each equation is scaled.
-      Eigen::MatrixXd Yl = Eigen::MatrixXd::Zero(k, static_cast<int>(columns.size()));
+      // rank(Y_l) by the sparse elimination, its rows (each scaled to unit norm, which leaves the rank alone)
+      // taken sparsest first: a connection that every stress of the link shares (the first hinge of a door)
+      // comes last and is reduced by the few-entry rows, instead of filling each of them.
+      std::vector<Eigen::Triplet<double>> triplets;
       for (int i = 0; i < k; ++i) {
-        for (const auto& [s, value] : stressesOfRow[rowsOfLink[l][i]])
-          Yl(i, columnOf[s]) = value;
-        const double norm = Yl.row(i).norm();
-        if (norm > 0.0)
-          Yl.row(i) /= norm;
+        for (const auto& [stress, value] : stressesOfRow[rowsOfLink[l][i]]) {
+          triplets.emplace_back(i, columnOf[stress], value);
+        }
       }
-      // Rank-revealing QR, the threshold relative to the largest pivot (the rows have unit norm).
-      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Yl);
-      qr.setThreshold(tolerance);
-      redundant[l] = static_cast<int>(qr.rank()) == needed;
+      SparseJacobian Yl(k, static_cast<int>(columns.size()));
+      Yl.setFromTriplets(triplets.begin(), triplets.end());
+      EliminationOptions options;
+      options.rowOrder.resize(k);
+      std::iota(options.rowOrder.begin(), options.rowOrder.end(), 0);
+      std::stable_sort(options.rowOrder.begin(), options.rowOrder.end(),
+                       [&](int a, int b) { return Yl.row(a).nonZeros() < Yl.row(b).nonZeros(); });
+      options.stopAtFullRank = true;
+      redundant[l] = computeSparseElimination(Yl, tolerance, options).rank == needed;
     }
     for (int s : columns)
       columnOf[s] = -1;
