@@ -1,6 +1,8 @@
 #pragma once
 
+#include <functional>
 #include <optional>
+#include <queue>
 #include <utility>
 #include <vector>
 
@@ -92,6 +94,9 @@ class SparseElimination {
   std::vector<double> values_;
   std::vector<char> present_, queued_;
   std::vector<int> touched_, visited_;
+  /// Pivot indices to reduce the current row by, oldest first: P_k is zero at the pivot columns of earlier
+  /// pivots, so fill only ever reaches later ones. Empty between rows; a member so that no row allocates one.
+  std::priority_queue<int, std::vector<int>, std::greater<int>> pending_;
   std::vector<std::pair<int, double>> multipliers_;
   std::vector<double> coefficient_;
   std::vector<char> traced_;

@@ -59,13 +59,10 @@ SparseElimination::Step SparseElimination::addRow(const SparseJacobian& J, int r
     }
     values_[column] += value;
   };
-  // Pivot indices to reduce by, oldest first: P_k is zero at the pivot columns of earlier pivots, so fill
-  // only ever reaches later ones.
-  std::priority_queue<int, std::vector<int>, std::greater<int>> pending;
   auto enqueue = [&](int k) {
     if (queued_[k] == 0) {
       queued_[k] = 1;
-      pending.push(k);
+      pending_.push(k);
     }
   };
   if (scale > 0.0) {
@@ -77,9 +74,9 @@ SparseElimination::Step SparseElimination::addRow(const SparseJacobian& J, int r
     }
   }
   visited_.clear();
-  while (!pending.empty()) {
-    const int k = pending.top();
-    pending.pop();
+  while (!pending_.empty()) {
+    const int k = pending_.top();
+    pending_.pop();
     visited_.push_back(k);
     const double value = values_[column_[k]];
     if (std::abs(value) <= kCancellationNoise) {
