@@ -12,6 +12,9 @@ struct RedundantConstraint {
   std::string name;       ///< Element name (link or connection).
   std::string kind;       ///< Equation kind ("coincident_point", …).
   std::string equation;   ///< Readable form.
+  /// "structural" (the design makes it dependent) or "configuration" (only this pose does: it is independent
+  /// at nearby poses the mechanism reaches).
+  std::string cause = "structural";
 };
 
 /// A connection with redundant equations: "k of n equations".
@@ -51,6 +54,27 @@ struct RankMargin {
   bool nearTolerance = false;           ///< A decision within tolerances::kNearDecisionFactor of the threshold.
 };
 
+/// A motion of an idle group of links while every other link stays put (Tsai 1999): a rod spinning between
+/// two ball joints, a slider sliding along the line of two parallel prismatic joints.
+struct PassiveMotion {
+  std::vector<std::string> links;  ///< The links of the group.
+  std::string description;         ///< "rod leg3 spins about the line through its two ball joints".
+};
+
+/// One tree joint's value at the analysed pose.
+struct JointValue {
+  std::string name;
+  double value = 0.0;  ///< [rad] or [m]
+};
+
+/// How the analysed pose was reached from the written (or previous) pose.
+struct AssemblyInfo {
+  double residual = 0.0;            ///< max |Phi| at the analysed pose [m].
+  int steps = 0;                    ///< Continuation steps taken towards the driven positions.
+  int iterations = 0;               ///< Newton iterations, all steps together.
+  std::vector<std::string> events;  ///< Branch points or dead points met, one readable line each.
+};
+
 /// Everything the CLI prints and the services return; field names follow the JSON keys.
 struct MobilityReport {
   std::string robot;
@@ -63,6 +87,11 @@ struct MobilityReport {
   int numConstraints = 0;
   int rank = 0;
   int numRedundant = 0;
+  int finiteDof = 0;      ///< Dimension of the configuration set near the pose (how it really moves).
+  bool singular = false;  ///< finiteDof != dof: the pose, not the design, adds first-order freedom.
+  int passiveDof = 0;     ///< Freedoms of idle groups (passiveMotions).
+  int outputDof = 0;      ///< finiteDof - passiveDof.
+  std::vector<PassiveMotion> passiveMotions;
   std::vector<int> nullityTrace;
   std::vector<RedundantConstraint> redundantConstraints;
   std::vector<RedundantJoint> redundantJoints;
@@ -76,6 +105,9 @@ struct MobilityReport {
   double characteristicLength = 1.0;   ///< [m]
   double closureResidualBefore = 0.0;  ///< [m]
   double closureResidualAfter = 0.0;   ///< [m]
+  std::vector<JointValue> positions;   ///< Every tree joint with a single value, in document order.
+  AssemblyInfo assembly;
+  std::vector<std::string> warnings;   ///< What was read but not understood (one line each).
 };
 
 /// @return The report as one JSON object (DESIGN.md §4), keys in a fixed order, numbers with 9 significant digits.

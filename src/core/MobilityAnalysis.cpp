@@ -59,6 +59,9 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   report.numCoordinates = model.numCoordinates();
   report.numConstraints = model.numConstraints();
   report.rank = ranks.rank;
+  // Placeholders of the motion work (finite mobility, passive freedoms): the first-order answer.
+  report.finiteDof = report.dof;
+  report.outputDof = report.dof;
   report.nullityTrace = ranks.nullityTrace;
   report.characteristicLength = model.characteristicLength;
   report.closureResidualBefore = analysis.assembled.initialResidual;

@@ -73,13 +73,23 @@ std::string toJson(const MobilityReport& r) {
   out << "  \"num_constraints\": " << r.numConstraints << ",\n";
   out << "  \"rank\": " << r.rank << ",\n";
   out << "  \"num_redundant\": " << r.numRedundant << ",\n";
+  out << "  \"finite_dof\": " << r.finiteDof << ",\n";
+  out << "  \"singular\": " << (r.singular ? "true" : "false") << ",\n";
+  out << "  \"passive_dof\": " << r.passiveDof << ",\n";
+  out << "  \"output_dof\": " << r.outputDof << ",\n";
+  out << "  \"passive_motions\": "
+      << array(r.passiveMotions,
+               [](const PassiveMotion& m) {
+                 return "{\"links\": " + array(m.links, quote) + ", \"description\": " + quote(m.description) + "}";
+               })
+      << ",\n";
   out << "  \"nullity_trace\": " << array(r.nullityTrace, [](int v) { return std::to_string(v); }) << ",\n";
   out << "  \"redundant_constraints\": "
       << array(r.redundantConstraints,
                [](const RedundantConstraint& c) {
                  return "{\"index\": " + std::to_string(c.index) + ", \"source\": " + quote(c.source) +
                         ", \"name\": " + quote(c.name) + ", \"kind\": " + quote(c.kind) +
-                        ", \"equation\": " + quote(c.equation) + "}";
+                        ", \"equation\": " + quote(c.equation) + ", \"cause\": " + quote(c.cause) + "}";
                })
       << ",\n";
   out << "  \"redundant_joints\": "
@@ -108,7 +118,16 @@ std::string toJson(const MobilityReport& r) {
       << ", \"near_tolerance\": " << (r.rankMargin.nearTolerance ? "true" : "false") << "},\n";
   out << "  \"characteristic_length\": " << number(r.characteristicLength) << ",\n";
   out << "  \"closure_residual\": {\"before\": " << number(r.closureResidualBefore, 3)
-      << ", \"after\": " << number(r.closureResidualAfter, 3) << "}\n";
+      << ", \"after\": " << number(r.closureResidualAfter, 3) << "},\n";
+  out << "  \"positions\": {";
+  for (size_t i = 0; i < r.positions.size(); ++i) {
+    out << (i ? ", " : "") << quote(r.positions[i].name) << ": " << number(r.positions[i].value, 12);
+  }
+  out << "},\n";
+  out << "  \"assembly\": {\"residual\": " << number(r.assembly.residual, 3) << ", \"steps\": " << r.assembly.steps
+      << ", \"iterations\": " << r.assembly.iterations << ", \"events\": " << array(r.assembly.events, quote)
+      << "},\n";
+  out << "  \"warnings\": " << array(r.warnings, quote) << "\n";
   out << "}\n";
   return out.str();
 }
