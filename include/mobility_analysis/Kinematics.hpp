@@ -18,6 +18,18 @@ using LinkPoses = std::vector<Eigen::Isometry3d>;
 LinkPoses computeTreePoses(const Mechanism& mechanism, const JointPositions& positions);
 
 /**
+ * @brief The inverse of computeTreePoses: every revolute, continuous and prismatic tree joint's value at
+ *        @p poses, read from the relative pose of its two links.
+ *
+ * Angles are in (-pi, pi], or the representative nearest @p reference's value where it names the joint (so a
+ * continuous joint followed through several turns keeps counting). Fixed, floating and other multi-freedom tree
+ * joints have no single value and are left out.
+ * @return Joint values [rad] or [m] by name.
+ */
+JointPositions computeJointPositions(const Mechanism& mechanism, const LinkPoses& poses,
+                                     const JointPositions& reference = {});
+
+/**
  * @brief How far @p joint is from holding at @p poses: the distance between its two joint-frame origins
  *        that the joint type forbids [m] plus the angle between axes it forbids [rad] times @p lengthScale.
  */

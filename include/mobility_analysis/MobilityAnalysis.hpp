@@ -1,6 +1,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "mobility_analysis/Assembly.hpp"
@@ -15,7 +16,9 @@ namespace mobility_analysis {
 /// Options of one analysis.
 struct AnalysisOptions {
   AnalysisMode mode = AnalysisMode::Auto;
-  JointPositions positions;     ///< Starting pose; empty: the URDF pose (all tree joints at 0).
+  JointPositions positions;     ///< Driven tree-joint values; empty: the URDF pose (all tree joints at 0).
+  /// Where the assembly starts (the previous state when following a motion); empty: the written pose.
+  std::optional<LinkPoses> startPoses;
   double rankTolerance = -1.0;  ///< Relative rank threshold; <= 0: tolerances::kRank.
   /// Called with a phase name and a fraction in [0, 1] during long analyses; may be empty.
   std::function<void(const std::string&, double)> progress;

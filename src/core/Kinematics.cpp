@@ -49,6 +49,31 @@ LinkPoses computeTreePoses(const Mechanism& mechanism, const JointPositions& pos
   return poses;
 }
 
+JointPositions computeJointPositions(const Mechanism& mechanism, const LinkPoses& poses,
+                                     const JointPositions& reference) {
+  JointPositions positions;
+  for (const Joint& joint : mechanism.joints) {
+    const bool turns = joint.type == JointType::Revolute || joint.type == JointType::Continuous;
+    if (joint.kind != ConnectionKind::TreeJoint || !(turns || joint.type == JointType::Prismatic))
+      continue;
+    // The child frame is the joint frame moved by motion(value): T = (T_parent * origin)^-1 * T_child.
+    const Eigen::Isometry3d motion = (poses[joint.link1] * joint.frame1).inverse() * poses[joint.link2];
+    double value = 0.0;
+    if (turns) {
+      const Eigen::Vector3d v = joint.axis.unitOrthogonal();
+      const Eigen::Vector3d turned = motion.linear() * v;
+      value = std::atan2(joint.axis.dot(v.cross(turned)), v.dot(turned));
+      const auto previous = reference.find(joint.name);
+      if (previous != reference.end())
+        value += 2.0 * M_PI * std::round((previous->second - value) / (2.0 * M_PI));
+    } else {
+      value = joint.axis.dot(motion.translation());
+    }
+    positions[joint.name] = value;
+  }
+  return positions;
+}
+
 double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int jointIndex, double lengthScale) {
   const Joint& joint = mechanism.joints[jointIndex];
   if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||

@@ -28,7 +28,8 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   };
   progress("assembly", 0.0);
   Result<AssembledMechanism> assembled =
-      assembleMechanism(mechanism, computeTreePoses(mechanism, options.positions), options.mode);
+      assembleMechanism(mechanism, options.startPoses ? *options.startPoses : computeTreePoses(mechanism, options.positions),
+                        options.mode);
   if (!isOk(assembled))
     return diagnosticOf(assembled);
   MobilityAnalysis analysis;
@@ -66,6 +67,14 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   report.characteristicLength = model.characteristicLength;
   report.closureResidualBefore = analysis.assembled.initialResidual;
   report.closureResidualAfter = analysis.assembled.finalResidual;
+  const JointPositions reached = computeJointPositions(mechanism, analysis.assembled.poses, options.positions);
+  for (const Joint& joint : mechanism.joints) {
+    const auto value = reached.find(joint.name);
+    if (joint.kind == ConnectionKind::TreeJoint && value != reached.end())
+      report.positions.push_back(JointValue{joint.name, value->second});
+  }
+  report.assembly.residual = analysis.assembled.finalResidual;
+  report.assembly.iterations = analysis.assembled.iterations;
   report.rankMargin.tolerance = tolerance;
   report.rankMargin.smallestKeptPivot = ranks.smallestKeptPivot;
   report.rankMargin.largestDroppedResidual = ranks.largestDroppedResidual;
