@@ -10,6 +10,10 @@ namespace {
 /// the turn; the triple-product form is used instead [-].
 constexpr double kDegenerateTwistRate = 1e-6;
 
+/// Two directions whose angle's sine is below this are parallel by design for the twist's cross form [-];
+/// well above an assembly's residual, well below any angle a designer draws.
+constexpr double kParallelPair = 1e-6;
+
 /// What a primitive's writer gets: the builder, the joint and its elements, and where equations go.
 struct JointContext {
   ModelBuilder& builder;
@@ -113,8 +117,11 @@ void writeFixedTwist(const JointContext& c) {
         eq.value = va.dot(vb);
       }
       // In space a cross component is invariant under a rigid motion of the whole mechanism only where
-      // a x b = 0, so that form is used for parallel pairs alone (in the plane it always is).
-      const bool parallel = va.cross(vb).norm() <= 1e-9 * scale;
+      // a x b = 0, so that form is used for parallel pairs alone (in the plane it always is). Parallel within
+      // kParallelPair, not exactly: an assembly that stopped at a residual of 1e-8 leaves a pair that is
+      // parallel by design 1e-8 apart, and its dot form a.b = 1 would be picked with a rate of 1e-8, a
+      // gradient that vanishes at the solution (one DOF too many).
+      const bool parallel = va.cross(vb).norm() <= kParallelPair * scale;
       const Eigen::Vector3d crossRate = (n * va.dot(vb) - vb * va.dot(n)) / scale;
       for (int k = planar ? 2 : 0; k < 3 && (planar || parallel); ++k) {
         const double rate = planar ? std::abs(va.dot(vb)) / scale : std::abs(crossRate[k]);
