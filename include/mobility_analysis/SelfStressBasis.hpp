@@ -30,6 +30,11 @@ struct SelfStressBasis {
   double smallestKeptPivot = 0.0;       ///< Of the sweep's elimination (see OrderedRank) [-].
   double largestDroppedResidual = 0.0;  ///< Likewise [-].
   int locallyResolved = 0;              ///< Stresses found by a local elimination around their equation.
+  /// A basis of the first-order motions (right null space of J, dim num_coordinates each) from the same
+  /// elimination; empty with motionsComputed false when there were more than kMaxMotions.
+  std::vector<Eigen::VectorXd> motions;
+  bool motionsComputed = false;
+  static constexpr size_t kMaxMotions = 256;
 };
 
 /// Progress of a long computation: a fraction in [0, 1]; may be empty.

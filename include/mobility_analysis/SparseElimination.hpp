@@ -71,6 +71,14 @@ class SparseElimination {
                                             size_t maxSupport = 0);
 
   int rank() const { return static_cast<int>(origin_.size()); }
+  /**
+   * @brief A basis of the right null space of the rows added so far (the first-order motions when every row
+   * of J was added): one vector per column that never became a pivot, 1 there and 0 at the other free
+   * columns, the pivot columns by back-substitution from the latest pivot row (each pivot row is zero at the
+   * pivot columns of earlier ones). Cost: the fill, per vector.
+   * @param[in] maxVectors give up (return nothing) when there are more free columns than this.
+   */
+  std::optional<std::vector<Eigen::VectorXd>> nullSpace(size_t maxVectors) const;
   int numColumns() const { return static_cast<int>(pivotOfColumn_.size()); }
   double smallestKeptPivot() const;  ///< 0 when no row was kept.
   double largestDroppedResidual() const { return largestDropped_; }

@@ -1,5 +1,6 @@
 #include "mobility_analysis/MobilityAnalysis.hpp"
 
+#include <algorithm>
 #include <set>
 
 #include "mobility_analysis/ConstraintJacobian.hpp"
@@ -8,6 +9,8 @@
 #include "mobility_analysis/RedundantLinks.hpp"
 #include "mobility_analysis/SelfStressBasis.hpp"
 #include "mobility_analysis/Tolerances.hpp"
+#include "mobility_analysis/analysis/FiniteMobility.hpp"
+#include "mobility_analysis/analysis/PassiveFreedoms.hpp"
 
 namespace mobility_analysis {
 
@@ -60,9 +63,16 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   report.numCoordinates = model.numCoordinates();
   report.numConstraints = model.numConstraints();
   report.rank = ranks.rank;
-  // Placeholders of the motion work (finite mobility, passive freedoms): the first-order answer.
-  report.finiteDof = report.dof;
-  report.outputDof = report.dof;
+  // How it really moves: the second-order test over the self-stresses and a step-and-project check.
+  progress("finite mobility", 0.85);
+  const FiniteMobility finite = analyzeFiniteMobility(model, analysis.assembled.q, J, basis, ranks, tolerance);
+  report.finiteDof = finite.finiteDof;
+  report.singular = finite.singular;
+  // Idle groups' motions (Tsai): a rod spinning between two balls, a link sliding between parallel slides.
+  const PassiveFreedoms passive = findPassiveFreedoms(mechanism, model, analysis.assembled.q, J);
+  report.passiveDof = std::min(passive.dof, report.finiteDof);
+  report.passiveMotions = passive.motions;
+  report.outputDof = report.finiteDof - report.passiveDof;
   report.nullityTrace = ranks.nullityTrace;
   report.characteristicLength = model.characteristicLength;
   report.closureResidualBefore = analysis.assembled.initialResidual;
@@ -98,6 +108,11 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
       continue;
     report.redundantConstraints.push_back(RedundantConstraint{r, toString(eq.source), elementName(eq),
                                                               toString(eq.kind), describeEquation(model, r)});
+    // Only the design makes joints and ground constraints redundant, not a pose.
+    if (finite.configurationCause[r]) {
+      report.redundantConstraints.back().cause = "configuration";
+      continue;
+    }
     if (eq.source == EquationSource::Joint)
       ++jointRedundant[eq.element];
     if (eq.source == EquationSource::Boundary)
@@ -114,8 +129,8 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
 
   progress("redundant links", 0.9);
   std::vector<bool> linkInLoop, jointInLoop;
-  findOverConstrainedLoops(mechanism, model, basis.stresses, linkInLoop, jointInLoop);
-  const std::vector<bool> linkRedundant = findRedundantLinks(mechanism, model, basis.stresses, tolerance);
+  findOverConstrainedLoops(mechanism, model, finite.structuralStresses, linkInLoop, jointInLoop);
+  const std::vector<bool> linkRedundant = findRedundantLinks(mechanism, model, finite.structuralStresses, tolerance);
   report.redundantLinksComputed = true;
   for (size_t l = 0; l < mechanism.links.size(); ++l) {
     if (linkRedundant[l])

@@ -234,6 +234,10 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
   basis.rank = elimination.rank();
   basis.smallestKeptPivot = elimination.smallestKeptPivot();
   basis.largestDroppedResidual = elimination.largestDroppedResidual();
+  if (std::optional<std::vector<Eigen::VectorXd>> motions = elimination.nullSpace(SelfStressBasis::kMaxMotions)) {
+    basis.motions = std::move(*motions);
+    basis.motionsComputed = true;
+  }
 
   // Each stress scaled to unit largest coefficient, rounding noise dropped.
   for (SelfStress& stress : basis.stresses) {

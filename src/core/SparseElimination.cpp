@@ -180,4 +180,29 @@ std::optional<SelfStress> SparseElimination::traceDependency(
   return stress;
 }
 
+std::optional<std::vector<Eigen::VectorXd>> SparseElimination::nullSpace(size_t maxVectors) const {
+  std::vector<int> freeColumns;
+  for (size_t c = 0; c < pivotOfColumn_.size(); ++c) {
+    if (pivotOfColumn_[c] < 0)
+      freeColumns.push_back(static_cast<int>(c));
+  }
+  if (freeColumns.size() > maxVectors)
+    return std::nullopt;
+  std::vector<Eigen::VectorXd> basis;
+  for (int f : freeColumns) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(numColumns());
+    x(f) = 1.0;
+    for (int k = rank() - 1; k >= 0; --k) {
+      double sum = 0.0;
+      for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
+        if (entries_[i].first != column_[k])
+          sum += entries_[i].second * x(entries_[i].first);
+      }
+      x(column_[k]) = -sum / pivot_[k];
+    }
+    basis.push_back(std::move(x));
+  }
+  return basis;
+}
+
 }  // namespace mobility_analysis

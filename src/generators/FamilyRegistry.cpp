@@ -60,6 +60,12 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"bricard", 0, 0, "bricard", "line-symmetric Bricard 6R; spatial DOF 1 G 0 R 1"},
       {"goldberg", 0, 0, "goldberg", "Goldberg 5R; spatial DOF 1 G -1 R 2"},
       {"rssr", 0, 0, "rssr", "RSSR, rod floating; spatial DOF 2 G 2 R 0"},
+      {"flattened_four_bar", 0, 0, "flattened_four_bar", "four-bar drawn flat; planar DOF 2 (finite 1) G 1 R 1"},
+      {"parallelogram_bifurcation", 0, 0, "parallelogram_bifurcation",
+       "parallelogram at its bifurcation; planar DOF 2 (finite 1) G 1 R 1"},
+      {"collinear_bars", 0, 0, "collinear_bars", "two collinear bars between ground pins; planar DOF 1 (finite 0)"},
+      {"stewart_6sps", 0, 0, "stewart_6sps", "Stewart-Gough 6-SPS; spatial DOF 12 (passive 6) G 12 R 0"},
+      {"delta_robot", 0, 0, "delta_robot", "Delta, ball-jointed parallelogram rods; spatial DOF 9 (passive 6)"},
       {"sle_mast", 0, 0, "sle_mast", "= sle_planar 4"},
       {"hoberman_ring", 0, 0, "hoberman_ring", "= hoberman 6"},
       {"door", 0, 1, "door [K=3]",
@@ -159,6 +165,16 @@ GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& r
     mechanism = makeGoldberg();
   } else if (family == "rssr") {
     mechanism = makeRssr();
+  } else if (family == "flattened_four_bar") {
+    mechanism = makeFlattenedFourBar();
+  } else if (family == "parallelogram_bifurcation") {
+    mechanism = makeParallelogramBifurcation();
+  } else if (family == "collinear_bars") {
+    mechanism = makeCollinearBars();
+  } else if (family == "stewart_6sps") {
+    mechanism = makeStewart6Sps();
+  } else if (family == "delta_robot") {
+    mechanism = makeDeltaRobot();
   } else if (family == "sle_mast") {
     mechanism = makeSlePlanarMast(4);
     mechanism.name = "sle_mast";

@@ -431,3 +431,153 @@ MechanismDescription makeRssr() {
 }
 
 }  // namespace mobility_analysis
+
+namespace mobility_analysis {
+
+MechanismDescription makeFlattenedFourBar() {
+  // Change-point four-bar: crank + coupler = ground + rocker (0.4 + 0.9 = 1.0 + 0.3), drawn flat.
+  const Eigen::Vector3d a = planar(0.0, 0.0), b = planar(0.4, 0.0), c = planar(1.3, 0.0), d = planar(1.0, 0.0);
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  MechanismDescription m;
+  m.name = "flattened_four_bar";
+  m.comment =
+      "Four-bar drawn flat: ground A(0,0)-D(1,0), crank AB 0.4, coupler BC 0.9, rocker CD 0.3 [m], all pins on\n"
+      "the x axis (B = (0.4,0), C = (1.3,0)). crank + coupler = ground + rocker (1.3 = 1.3): a change-point\n"
+      "four-bar, and the flat pose is where its two branches cross. First order: DOF 2 (the nullity), Gruebler 1,\n"
+      "1 redundant equation; the mechanism moves along either branch with 1 DOF: finite_dof 1, singular, and\n"
+      "the redundancy's cause is the configuration.";
+  m.links = {link("ground", {a, d}), link("crank", {a, b}), link("coupler", {b, c}), link("rocker", {c, d})};
+  m.connections = {makeRevolute("ground_crank", "ground", "crank", a, z),
+                   makeRevolute("crank_coupler", "crank", "coupler", b, z),
+                   makeRevolute("coupler_rocker", "coupler", "rocker", c, z),
+                   makeRevolute("rocker_ground", "rocker", "ground", d, z)};
+  m.expectations = {expectation("planar", 2, 1)};
+  return m;
+}
+
+MechanismDescription makeParallelogramBifurcation() {
+  const Eigen::Vector3d a = planar(0.0, 0.0), b = planar(0.5, 0.0), c = planar(1.5, 0.0), d = planar(1.0, 0.0);
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  MechanismDescription m;
+  m.name = "parallelogram_bifurcation";
+  m.comment =
+      "Parallelogram four-bar at its bifurcation pose: ground A(0,0)-D(1,0), cranks AB = DC = 0.5, coupler\n"
+      "BC = 1 [m], both cranks along +x (B = (0.5,0), C = (1.5,0)), all pins collinear. Here the parallelogram\n"
+      "branch and the anti-parallelogram branch cross. First order: DOF 2, Gruebler 1, 1 redundant equation;\n"
+      "finite_dof 1, singular, cause configuration.";
+  m.links = {link("ground", {a, d}), link("crank1", {a, b}), link("coupler", {b, c}), link("crank2", {c, d})};
+  m.connections = {makeRevolute("ground_crank1", "ground", "crank1", a, z),
+                   makeRevolute("crank1_coupler", "crank1", "coupler", b, z),
+                   makeRevolute("coupler_crank2", "coupler", "crank2", c, z),
+                   makeRevolute("crank2_ground", "crank2", "ground", d, z)};
+  m.expectations = {expectation("planar", 2, 1)};
+  return m;
+}
+
+MechanismDescription makeCollinearBars() {
+  const Eigen::Vector3d a = planar(0.0, 0.0), b = planar(0.5, 0.0), c = planar(1.0, 0.0);
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  MechanismDescription m;
+  m.name = "collinear_bars";
+  m.comment =
+      "Two equal bars collinear between two ground pins: A(0,0) and C(1,0) on the ground, bar1 A-B and bar2\n"
+      "B-C of 0.5 m, B = (0.5,0) [m]. Gruebler 3 (3 - 1) - 3 * 2 = 0: a structure. B may move across the line\n"
+      "to first order (DOF 1, 1 redundant equation), but not at all in fact: finite_dof 0, singular, cause\n"
+      "configuration (the classic example of a first-order infinitesimal mechanism).";
+  m.links = {link("ground", {a, c}), link("bar1", {a, b}), link("bar2", {b, c})};
+  m.connections = {makeRevolute("pin_a", "ground", "bar1", a, z), makeRevolute("pin_b", "bar1", "bar2", b, z),
+                   makeRevolute("pin_c", "bar2", "ground", c, z)};
+  m.expectations = {expectation("planar", 1, 0)};
+  return m;
+}
+
+MechanismDescription makeStewart6Sps() {
+  // Base joints at radius 1 m, angles 120 k +- 15 deg; platform joints at radius 0.5 m, height 1 m, angles
+  // 60 + 120 k +- 15 deg; leg i joins base joint i to the platform joint next to it.
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  MechanismDescription m;
+  m.name = "stewart_6sps";
+  m.comment =
+      "Stewart-Gough platform, 6-SPS. Base ball joints B_i at radius 1 m, angles 120k -15 and 120k +15 deg\n"
+      "(k = 0, 1, 2); platform ball joints P_i at radius 0.5 m, height 1 m, angles 120k - 45 and 120k + 45 deg;\n"
+      "leg i runs from B_i to P_i: a cylinder (ball at B_i) and a piston (ball at P_i) joined by a prismatic\n"
+      "joint along the leg at its midpoint. Cylinders, pistons' parents and the platform hang by floating\n"
+      "joints. Gruebler 6 (14 - 18 - 1) + 6 (3 + 1 + 3) = 12 = DOF: the platform's 6 and each leg's spin about\n"
+      "its own line (Tsai 1999: passive), so passive_dof 6, output_dof 6.";
+  std::vector<Eigen::Vector3d> base, top;
+  for (int k = 0; k < 3; ++k) {
+    for (int s : {-1, 1}) {
+      const double angleBase = (120.0 * k + 15.0 * s) * kDeg;
+      const double angleTop = (120.0 * k + 45.0 * s) * kDeg;
+      base.push_back(Eigen::Vector3d(std::cos(angleBase), std::sin(angleBase), 0.0));
+      top.push_back(Eigen::Vector3d(0.5 * std::cos(angleTop), 0.5 * std::sin(angleTop), 1.0));
+    }
+  }
+  LinkDescription platform = link("platform", {top[0], top[1], top[2], top[3], top[4], top[5], top[0]});
+  platform.floatingFrame = frameFromAxis(Eigen::Vector3d(0.0, 0.0, 1.0), z);
+  m.links = {link("ground", {base[0], base[1], base[2], base[3], base[4], base[5], base[0]}), platform};
+  for (int i = 0; i < 6; ++i) {
+    const std::string n = std::to_string(i + 1);
+    const Eigen::Vector3d axis = (top[i] - base[i]).normalized();
+    const Eigen::Vector3d middle = 0.5 * (base[i] + top[i]);
+    LinkDescription cylinder = link("cylinder" + n, {base[i], middle});
+    cylinder.floatingFrame = frameFromAxis(base[i], axis);
+    m.links.push_back(cylinder);
+    m.links.push_back(link("piston" + n, {middle, top[i]}));
+    m.connections.push_back(makePrismatic("slide" + n, "cylinder" + n, "piston" + n, middle, axis));
+  }
+  for (int i = 0; i < 6; ++i) {
+    const std::string n = std::to_string(i + 1);
+    m.connections.push_back(makeSpherical("base_ball" + n, "ground", "cylinder" + n, base[i]));
+    m.connections.push_back(makeSpherical("top_ball" + n, "piston" + n, "platform", top[i]));
+  }
+  m.visualRadius = 0.015;
+  m.expectations = {expectation("spatial", 12, 12)};
+  return m;
+}
+
+MechanismDescription makeDeltaRobot() {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  const double baseRadius = 0.2, armLength = 0.2, armAngle = 30.0 * kDeg, platformRadius = 0.05;
+  const double halfWidth = 0.03;
+  const Eigen::Vector3d centre(0.0, 0.0, -0.35);
+  MechanismDescription m;
+  m.name = "delta_robot";
+  m.comment =
+      "Delta robot (Clavel) with ball-jointed parallelogram rods. Arm i (i = 0, 1, 2 at 0, 120, 240 deg):\n"
+      "ground revolute at radius 0.2 m about the tangent t_i, arm 0.2 m long pointing out and 30 deg down;\n"
+      "two balls at the arm's end E_i +- 0.03 t_i and two on the platform at C + 0.05 u_i +- 0.03 t_i with\n"
+      "C = (0, 0, -0.35) m; each of the two rods of an arm joins a pair (the rods of an arm are equal and\n"
+      "parallel: a parallelogram). Rods and platform hang by floating joints. Gruebler 6 (11 - 15 - 1) + 3 + 36\n"
+      "= 9 = DOF: the platform's 3 translations and each rod's spin about its own line (passive_dof 6,\n"
+      "output_dof 3).";
+  LinkDescription platform = link("platform");
+  platform.floatingFrame = frameFromAxis(centre, z);
+  m.links = {link("ground"), platform};
+  std::vector<Connection> balls;
+  for (int i = 0; i < 3; ++i) {
+    const std::string n = std::to_string(i + 1);
+    const double phi = 120.0 * i * kDeg;
+    const Eigen::Vector3d u(std::cos(phi), std::sin(phi), 0.0), t(-std::sin(phi), std::cos(phi), 0.0);
+    const Eigen::Vector3d pivot = baseRadius * u;
+    const Eigen::Vector3d end = pivot + armLength * (std::cos(armAngle) * u - std::sin(armAngle) * z);
+    m.links.push_back(link("arm" + n, {pivot, end}));
+    m.connections.push_back(makeRevolute("shoulder" + n, "ground", "arm" + n, pivot, t));
+    for (int s : {-1, 1}) {
+      const std::string rod = "rod" + n + (s < 0 ? "a" : "b");
+      const Eigen::Vector3d top = end + s * halfWidth * t;
+      const Eigen::Vector3d bottom = centre + platformRadius * u + s * halfWidth * t;
+      LinkDescription r = link(rod, {top, bottom});
+      r.floatingFrame = frameFromAxis(top, bottom - top);
+      m.links.push_back(r);
+      balls.push_back(makeSpherical(rod + "_top", "arm" + n, rod, top));
+      balls.push_back(makeSpherical(rod + "_bottom", rod, "platform", bottom));
+    }
+  }
+  m.connections.insert(m.connections.end(), balls.begin(), balls.end());
+  m.visualRadius = 0.008;
+  m.expectations = {expectation("spatial", 9, 9)};
+  return m;
+}
+
+}  // namespace mobility_analysis

@@ -16,6 +16,9 @@ struct Reference {
   std::vector<std::string> redundantLinks;   ///< Exactly these (DESIGN.md §3 definition).
   std::vector<std::string> redundantJoints;  ///< When non-empty: exactly these carry the redundant equations.
   bool standard = true;                      ///< Standard joint types: coordinates - constraints == Grübler.
+  int finite = -1;                           ///< finite_dof (-1: equal to dof, a regular pose).
+  int passive = 0;                           ///< passive_dof (Tsai's idle groups).
+  int configuration = 0;                     ///< Redundant equations whose cause is the pose.
 };
 
 std::ostream& operator<<(std::ostream& out, const Reference& r) {
@@ -34,7 +37,7 @@ const std::vector<Reference>& references() {
       // Not in the design table: in space the whole redundancy falls on the closing slide, as for any single
       // loop (each slide's twist is held by a triple product, see NaturalCoordinates).
       {"three_sliders.urdf", AnalysisMode::Spatial, 1, -3, 4, {}, {"slide_ca"}},
-      {"rppr.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
+      {"rppr.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}, true, -1, 1},
       {"bennett.urdf", AnalysisMode::Spatial, 1, -2, 3, {}, {"j4"}},
       {"bennett.urdf", AnalysisMode::Auto, 1, -2, 3, {}, {"j4"}},
       {"door.urdf", AnalysisMode::Spatial, 1, -9, 10, {}, {}},
@@ -43,7 +46,15 @@ const std::vector<Reference>& references() {
       {"sarrus.urdf", AnalysisMode::Spatial, 1, 0, 1, {}, {}},
       {"bricard.urdf", AnalysisMode::Spatial, 1, 0, 1, {}, {}},
       {"goldberg.urdf", AnalysisMode::Spatial, 1, -1, 2, {}, {}},
-      {"rssr.urdf", AnalysisMode::Spatial, 2, 2, 0, {}, {}},
+      {"rssr.urdf", AnalysisMode::Spatial, 2, 2, 0, {}, {}, true, -1, 1},
+      // Singular poses (DESIGN.md §5): the nullity counts a first-order freedom the mechanism does not have.
+      {"flattened_four_bar.urdf", AnalysisMode::Planar, 2, 1, 1, {}, {}, true, 1, 0, 1},
+      {"flattened_four_bar.urdf", AnalysisMode::Auto, 2, 1, 1, {}, {}, true, 1, 0, 1},
+      {"parallelogram_bifurcation.urdf", AnalysisMode::Planar, 2, 1, 1, {}, {}, true, 1, 0, 1},
+      {"collinear_bars.urdf", AnalysisMode::Planar, 1, 0, 1, {}, {}, true, 0, 0, 1},
+      // Passive freedoms (Tsai 1999): each leg or rod spins about its own line.
+      {"stewart_6sps.urdf", AnalysisMode::Spatial, 12, 12, 0, {}, {}, true, -1, 6},
+      {"delta_robot.urdf", AnalysisMode::Spatial, 9, 9, 0, {}, {}, true, -1, 6},
       {"sle_mast.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
       {"hoberman_ring.urdf", AnalysisMode::Planar, 1, -3, 4, {}, {}},
   };
@@ -88,6 +99,24 @@ TEST_P(ReferenceMechanism, GivesItsDofGrublerCountAndRedundancy) {
   EXPECT_LT(report.closureResidualBefore, 1e-9 * std::max(1.0, report.characteristicLength))
       << "the bundled file is not written closed";
   EXPECT_FALSE(report.rankMargin.nearTolerance);
+
+  // How it really moves.
+  const int finite = ref.finite < 0 ? ref.dof : ref.finite;
+  EXPECT_EQ(report.finiteDof, finite);
+  EXPECT_EQ(report.singular, finite != ref.dof);
+  EXPECT_EQ(report.passiveDof, ref.passive);
+  EXPECT_EQ(report.outputDof, finite - ref.passive);
+  EXPECT_EQ(report.passiveMotions.size(), static_cast<size_t>(ref.passive));
+  int configuration = 0;
+  for (const RedundantConstraint& c : report.redundantConstraints)
+    configuration += c.cause == "configuration" ? 1 : 0;
+  EXPECT_EQ(configuration, ref.configuration);
+  if (ref.configuration == ref.redundant) {
+    // Only the pose makes anything dependent: no joint, link or ground constraint is called redundant.
+    EXPECT_TRUE(report.redundantJoints.empty());
+    EXPECT_TRUE(report.redundantLinks.empty());
+    EXPECT_TRUE(report.redundantBoundaries.empty());
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(DesignTable, ReferenceMechanism, ::testing::ValuesIn(references()),
@@ -131,4 +160,24 @@ TEST(ReferenceMechanisms, ParallelogramThirdCrankAndEachCrankAreRedundantLinks) 
             report.redundantLinks.end());
   // "each crank qualifies": three cranks, and the coupler does not (removing it frees the cranks).
   EXPECT_EQ(report.redundantLinks.size(), 3u);
+}
+
+TEST(ReferenceMechanisms, PassiveMotionsNameTheirGroupAndWhatItDoes) {
+  const MobilityReport rssr = analyzeOrFail(urdfPath("rssr.urdf"), AnalysisMode::Spatial).report;
+  ASSERT_EQ(rssr.passiveMotions.size(), 1u);
+  EXPECT_EQ(rssr.passiveMotions[0].links, std::vector<std::string>{"rod"});
+  EXPECT_EQ(rssr.passiveMotions[0].description,
+            "link rod spins about the line through its ball joints s1 and s2");
+  const MobilityReport rppr = analyzeOrFail(urdfPath("rppr.urdf"), AnalysisMode::Planar).report;
+  ASSERT_EQ(rppr.passiveMotions.size(), 1u);
+  EXPECT_EQ(rppr.passiveMotions[0].links, std::vector<std::string>{"link2"});
+  EXPECT_EQ(rppr.passiveMotions[0].description,
+            "link link2 slides along the line of its prismatic joints slide_1 and slide_2");
+  // A 6-SPS leg is a chain of two links turning together.
+  const MobilityReport stewart = analyzeOrFail(urdfPath("stewart_6sps.urdf"), AnalysisMode::Spatial).report;
+  for (const PassiveMotion& motion : stewart.passiveMotions)
+    EXPECT_EQ(motion.links.size(), 2u) << motion.description;
+  // A door on its hinges and a robot's last link turn on one link only: output, not idle.
+  EXPECT_EQ(analyzeOrFail(urdfPath("door.urdf"), AnalysisMode::Spatial).report.passiveDof, 0);
+  EXPECT_EQ(analyzeOrFail(urdfPath("puma560.urdf"), AnalysisMode::Spatial).report.passiveDof, 0);
 }

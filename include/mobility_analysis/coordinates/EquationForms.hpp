@@ -39,7 +39,7 @@ class ElementView {
 
  private:
   const CoordinateModel& model_;
-  const Eigen::Ref<const Eigen::VectorXd>& q_;
+  Eigen::Ref<const Eigen::VectorXd> q_;  ///< A view (by value: a view of a temporary would dangle).
   int dim_;
 };
 

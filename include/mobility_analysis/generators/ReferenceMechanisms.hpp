@@ -94,4 +94,19 @@ MechanismDescription makeGoldberg(double theta1 = 100.0 * M_PI / 180.0);
  */
 MechanismDescription makeRssr();
 
+/// Change-point four-bar drawn flat (all pins collinear): planar DOF 2, finite 1, Grübler 1, 1 redundant.
+MechanismDescription makeFlattenedFourBar();
+
+/// Parallelogram four-bar at its bifurcation pose (flat): planar DOF 2, finite 1, Grübler 1, 1 redundant.
+MechanismDescription makeParallelogramBifurcation();
+
+/// Two equal bars collinear between two ground pins: planar DOF 1, finite 0, Grübler 0, 1 redundant.
+MechanismDescription makeCollinearBars();
+
+/// Stewart–Gough 6-SPS: spatial DOF 12 (passive 6, output 6), Grübler 12.
+MechanismDescription makeStewart6Sps();
+
+/// Delta robot with ball-jointed parallelogram rods: spatial DOF 9 (passive 6, output 3), Grübler 9.
+MechanismDescription makeDeltaRobot();
+
 }  // namespace mobility_analysis

@@ -1,0 +1,259 @@
+#include "mobility_analysis/analysis/PassiveFreedoms.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <set>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+#include "mobility_analysis/coordinates/EquationForms.hpp"
+
+namespace mobility_analysis {
+
+namespace {
+
+/// A twist of the group is a first-order motion when |A xi| is below this fraction of |A| |xi| [-].
+constexpr double kTwistNullity = 1e-8;
+/// The finite check turns or slides the group this far [rad] or [normalised length].
+constexpr double kFiniteStep = 0.05;
+/// ... and accepts the motion when no constraint moves more than this [normalised length].
+constexpr double kFiniteResidual = 1e-9;
+/// Longest chain of links an idle group may be.
+constexpr size_t kMaxGroup = 3;
+
+/// The finite rigid motion exp(xi) of a twist (omega, v) (Murray, Li & Sastry, eq. 2.36).
+Eigen::Isometry3d exponential(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) {
+  Eigen::Isometry3d g = Eigen::Isometry3d::Identity();
+  const double angle = omega.norm();
+  if (angle < 1e-12) {
+    g.translation() = v;
+    return g;
+  }
+  const Eigen::Vector3d w = omega / angle, u = v / angle;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, w).toRotationMatrix();
+  g.linear() = R;
+  g.translation() = (Eigen::Matrix3d::Identity() - R) * w.cross(u) + w * w.dot(u) * angle;
+  return g;
+}
+
+}  // namespace
+
+PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const CoordinateModel& model,
+                                    const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J) {
+  PassiveFreedoms result;
+  const int numLinks = static_cast<int>(mechanism.links.size());
+  const int dim = model.dim;
+  const bool planar = dim == 2;
+  const int lambda = model.lambda;
+  // Connections that constrain, and the links they join.
+  std::vector<int> equationsOf(mechanism.joints.size(), 0);
+  for (const ConstraintEquation& eq : model.equations) {
+    if (eq.source == EquationSource::Joint)
+      ++equationsOf[eq.element];
+  }
+  std::vector<std::vector<int>> connectionsAt(numLinks);
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    if (equationsOf[j] == 0)
+      continue;
+    connectionsAt[mechanism.joints[j].link1].push_back(static_cast<int>(j));
+    connectionsAt[mechanism.joints[j].link2].push_back(static_cast<int>(j));
+  }
+  // Candidate groups: every link but the ground, and chains of links with two connections each.
+  std::set<std::vector<int>> groups;
+  for (int l = 0; l < numLinks; ++l) {
+    if (l == mechanism.rootLink || connectionsAt[l].empty())
+      continue;
+    groups.insert({l});
+    std::vector<int> chain = {l};
+    std::function<void(std::vector<int>&)> extend = [&](std::vector<int>& path) {
+      if (path.size() >= kMaxGroup)
+        return;
+      const int last = path.back();
+      if (connectionsAt[last].size() != 2)
+        return;
+      for (int j : connectionsAt[last]) {
+        const Joint& joint = mechanism.joints[j];
+        const int next = joint.link1 == last ? joint.link2 : joint.link1;
+        if (next == mechanism.rootLink || connectionsAt[next].size() != 2 ||
+            std::find(path.begin(), path.end(), next) != path.end())
+          continue;
+        path.push_back(next);
+        std::vector<int> sorted = path;
+        std::sort(sorted.begin(), sorted.end());
+        groups.insert(sorted);
+        extend(path);
+        path.pop_back();
+      }
+    };
+    if (connectionsAt[l].size() == 2)
+      extend(chain);
+  }
+
+  const Eigen::SparseMatrix<double> Jc = J;  // column access
+  auto element3 = [&](int e) {
+    const int o = model.elements[e].offset;
+    return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
+  };
+  std::vector<Eigen::VectorXd> accepted;  // motions kept, full length
+  std::vector<std::vector<int>> acceptedLinks;
+  for (const std::vector<int>& group : groups) {
+    std::vector<char> inGroup(numLinks, 0);
+    for (int l : group)
+      inGroup[l] = 1;
+    // T: coordinates of the group's elements per twist component (space: omega, v; plane: omega_z, v_x, v_y).
+    // Its end connections must reach at least two other links: a link turning on connections to one link
+    // only (a door on its hinges, a robot's last link) is that link's output, not an idle motion.
+    std::set<int> outside;
+    for (int l : group) {
+      for (int j : connectionsAt[l]) {
+        const Joint& joint = mechanism.joints[j];
+        if (!inGroup[joint.link1])
+          outside.insert(joint.link1);
+        if (!inGroup[joint.link2])
+          outside.insert(joint.link2);
+      }
+    }
+    if (outside.size() < 2)
+      continue;
+    std::vector<int> elements;
+    for (int l : group)
+      elements.insert(elements.end(), model.bodyElements[l].begin(), model.bodyElements[l].end());
+    std::vector<int> columns;
+    Eigen::MatrixXd T(static_cast<Eigen::Index>(elements.size()) * dim, lambda);
+    for (size_t i = 0; i < elements.size(); ++i) {
+      const Eigen::Vector3d x = element3(elements[i]);
+      const bool isPoint = model.elements[elements[i]].isPoint;
+      Eigen::Matrix<double, 3, 6> block;  // d(x)/d(omega, v): -[x]x and (points) I
+      block.leftCols<3>() << 0.0, x.z(), -x.y(), -x.z(), 0.0, x.x(), x.y(), -x.x(), 0.0;
+      block.rightCols<3>() =
+          isPoint ? Eigen::Matrix3d(Eigen::Matrix3d::Identity()) : Eigen::Matrix3d(Eigen::Matrix3d::Zero());
+      for (int k = 0; k < dim; ++k) {
+        columns.push_back(model.elements[elements[i]].offset + k);
+        if (planar)
+          T.row(static_cast<Eigen::Index>(i) * dim + k) << block(k, 2), block(k, 3), block(k, 4);
+        else
+          T.row(static_cast<Eigen::Index>(i) * dim + k) = block.row(k);
+      }
+    }
+    // A = J(rows touching the group, group columns) T, rows scaled to unit norm.
+    std::vector<int> rows;
+    for (int c : columns) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(Jc, c); it; ++it)
+        rows.push_back(static_cast<int>(it.row()));
+    }
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    Eigen::MatrixXd Jsub = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), columns.size());
+    for (size_t r = 0; r < rows.size(); ++r) {
+      const double norm = J.row(rows[r]).norm();
+      for (size_t c = 0; c < columns.size(); ++c)
+        Jsub(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
+            J.coeff(rows[r], columns[c]) / norm;
+    }
+    const Eigen::MatrixXd A = Jsub * T;
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+    const Eigen::VectorXd sigma = svd.singularValues();
+    const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
+    for (int k = 0; k < lambda; ++k) {
+      if (k < sigma.size() && sigma(k) > kTwistNullity * std::max(largest, 1.0))
+        continue;
+      Eigen::VectorXd xi = svd.matrixV().col(k);
+      Eigen::Vector3d omega, v;
+      if (planar) {
+        omega = Eigen::Vector3d(0.0, 0.0, xi(0));
+        v = Eigen::Vector3d(xi(1), xi(2), 0.0);
+      } else {
+        omega = xi.head<3>();
+        v = xi.tail<3>();
+      }
+      // Finite: the group moved by exp(step xi) keeps every constraint.
+      const double scale = kFiniteStep / std::max(omega.norm(), v.norm());
+      const Eigen::Isometry3d g = exponential(scale * omega, scale * v);
+      Eigen::VectorXd moved = q;
+      for (int e : elements) {
+        const Eigen::Vector3d x = element3(e);
+        const Eigen::Vector3d y = model.elements[e].isPoint ? (g * x).eval() : (g.linear() * x).eval();
+        moved.segment(model.elements[e].offset, dim) = y.head(dim);
+      }
+      // Only the rows touching the group can change.
+      const ElementView before(model, q), after(model, moved);
+      double change = 0.0;
+      for (int r : rows) {
+        const ConstraintEquation& eq = model.equations[r];
+        change = std::max(change, std::abs(visitForm(eq.form, [&](auto form) {
+                            return form.value(after, eq) - form.value(before, eq);
+                          })));
+      }
+      if (change > kFiniteResidual)
+        continue;
+      // Independent of the motions already kept (only those sharing a link can be dependent).
+      Eigen::VectorXd motion = Eigen::VectorXd::Zero(model.numCoordinates());
+      const Eigen::VectorXd local = T * xi;
+      for (size_t c = 0; c < columns.size(); ++c)
+        motion(columns[c]) = local(static_cast<Eigen::Index>(c));
+      std::vector<Eigen::VectorXd> overlapping;
+      for (size_t a = 0; a < accepted.size(); ++a) {
+        for (int l : acceptedLinks[a]) {
+          if (inGroup[l]) {
+            overlapping.push_back(accepted[a]);
+            break;
+          }
+        }
+      }
+      if (!overlapping.empty()) {
+        Eigen::MatrixXd stack(model.numCoordinates(), static_cast<Eigen::Index>(overlapping.size()) + 1);
+        for (size_t a = 0; a < overlapping.size(); ++a)
+          stack.col(static_cast<Eigen::Index>(a)) = overlapping[a].normalized();
+        stack.col(stack.cols() - 1) = motion.normalized();
+        Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(stack);
+        qr.setThreshold(1e-6);
+        if (qr.rank() < stack.cols())
+          continue;
+      }
+      accepted.push_back(motion);
+      acceptedLinks.push_back(group);
+      // The phrase: the group, what it does, and the connections it turns or slides between.
+      PassiveMotion passive;
+      std::string names;
+      for (int l : group) {
+        passive.links.push_back(mechanism.links[l].name);
+        names += (names.empty() ? "" : "-") + mechanism.links[l].name;
+      }
+      std::vector<int> ends;
+      std::set<std::string> types;
+      for (int l : group) {
+        for (int j : connectionsAt[l]) {
+          const Joint& joint = mechanism.joints[j];
+          if (inGroup[joint.link1] && inGroup[joint.link2])
+            continue;
+          ends.push_back(j);
+          types.insert(joint.kind == ConnectionKind::DistanceConstraint ? "distance" : toString(joint.type));
+        }
+      }
+      std::string endText;
+      for (size_t i = 0; i < ends.size(); ++i)
+        endText += (i == 0 ? "" : (i + 1 == ends.size() ? " and " : ", ")) + mechanism.joints[ends[i]].name;
+      const std::string jointWord =
+          types.size() == 1 && *types.begin() == "spherical"   ? "ball joints"
+          : types.size() == 1 && *types.begin() == "prismatic" ? "prismatic joints"
+          : types.size() == 1 && (*types.begin() == "revolute" || *types.begin() == "continuous")
+              ? "revolute joints"
+              : "joints";
+      const std::string subject = (group.size() == 1 ? "link " : "chain ") + names;
+      if (omega.norm() < 1e-9 * v.norm()) {
+        passive.description = subject + " slides along the line of its " + jointWord + " " + endText;
+      } else if (std::abs(omega.normalized().dot(v)) > 1e-6 * v.norm() + 1e-12) {
+        passive.description = subject + " screws about the line of its " + jointWord + " " + endText;
+      } else {
+        passive.description = subject + " spins about the line through its " + jointWord + " " + endText;
+      }
+      result.motions.push_back(std::move(passive));
+    }
+  }
+  result.dof = static_cast<int>(result.motions.size());
+  return result;
+}
+
+}  // namespace mobility_analysis
