@@ -451,7 +451,7 @@ MechanismDescription makeFlattenedFourBar() {
                    makeRevolute("crank_coupler", "crank", "coupler", b, z),
                    makeRevolute("coupler_rocker", "coupler", "rocker", c, z),
                    makeRevolute("rocker_ground", "rocker", "ground", d, z)};
-  m.expectations = {expectation("planar", 2, 1)};
+  m.expectations = {expectation("planar", 2, 1), expectation("spatial", 2, -2)};
   return m;
 }
 
@@ -470,7 +470,7 @@ MechanismDescription makeParallelogramBifurcation() {
                    makeRevolute("crank1_coupler", "crank1", "coupler", b, z),
                    makeRevolute("coupler_crank2", "coupler", "crank2", c, z),
                    makeRevolute("crank2_ground", "crank2", "ground", d, z)};
-  m.expectations = {expectation("planar", 2, 1)};
+  m.expectations = {expectation("planar", 2, 1), expectation("spatial", 2, -2)};
   return m;
 }
 
@@ -487,7 +487,7 @@ MechanismDescription makeCollinearBars() {
   m.links = {link("ground", {a, c}), link("bar1", {a, b}), link("bar2", {b, c})};
   m.connections = {makeRevolute("pin_a", "ground", "bar1", a, z), makeRevolute("pin_b", "bar1", "bar2", b, z),
                    makeRevolute("pin_c", "bar2", "ground", c, z)};
-  m.expectations = {expectation("planar", 1, 0)};
+  m.expectations = {expectation("planar", 1, 0), expectation("spatial", 1, -3)};
   return m;
 }
 

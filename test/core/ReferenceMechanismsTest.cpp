@@ -52,6 +52,9 @@ const std::vector<Reference>& references() {
       {"flattened_four_bar.urdf", AnalysisMode::Auto, 2, 1, 1, {}, {}, true, 1, 0, 1},
       {"parallelogram_bifurcation.urdf", AnalysisMode::Planar, 2, 1, 1, {}, {}, true, 1, 0, 1},
       {"collinear_bars.urdf", AnalysisMode::Planar, 1, 0, 1, {}, {}, true, 0, 0, 1},
+      // In space the planar loop's 3 structural redundancies stay; the pose adds the fourth.
+      {"flattened_four_bar.urdf", AnalysisMode::Spatial, 2, -2, 4, {}, {}, true, 1, 0, 1},
+      {"collinear_bars.urdf", AnalysisMode::Spatial, 1, -3, 4, {}, {}, true, 0, 0, 1},
       // Passive freedoms (Tsai 1999): each leg or rod spins about its own line.
       {"stewart_6sps.urdf", AnalysisMode::Spatial, 12, 12, 0, {}, {}, true, -1, 6},
       {"delta_robot.urdf", AnalysisMode::Spatial, 9, 9, 0, {}, {}, true, -1, 6},
