@@ -60,12 +60,13 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     connectionsAt[mechanism.joints[j].link1].push_back(static_cast<int>(j));
     connectionsAt[mechanism.joints[j].link2].push_back(static_cast<int>(j));
   }
-  // Candidate groups: every link but the ground, and chains of links with two connections each.
+  // Candidate groups: every link with two connections but the ground, and chains of such links.
   std::set<std::vector<int>> groups;
   for (int l = 0; l < numLinks; ++l) {
     if (l == mechanism.rootLink || connectionsAt[l].empty())
       continue;
-    groups.insert({l});
+    if (connectionsAt[l].size() == 2)
+      groups.insert({l});
     std::vector<int> chain = {l};
     std::function<void(std::vector<int>&)> extend = [&](std::vector<int>& path) {
       if (path.size() >= kMaxGroup)
@@ -115,7 +116,12 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
           outside.insert(joint.link2);
       }
     }
-    if (outside.size() < 2)
+    int ends = 0;
+    for (int l : group) {
+      for (int j : connectionsAt[l])
+        ends += inGroup[mechanism.joints[j].link1] && inGroup[mechanism.joints[j].link2] ? 0 : 1;
+    }
+    if (outside.size() < 2 || ends != 2)
       continue;
     std::vector<int> elements;
     for (int l : group)
