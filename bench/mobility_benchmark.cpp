@@ -1,15 +1,16 @@
-/// mobility_benchmark --method full|literal|dense FILE.urdf [--mode auto|planar|spatial] [--budget SECONDS]
+/// mobility_benchmark --method full|finite|literal|dense FILE.urdf [--mode auto|planar|spatial] [--budget SECONDS]
 ///
 /// Measures one method on one model in this process and prints one line:
-///   method=<m> file=<f> coordinates=<n> equations=<m> dof=<d> redundant=<r> seconds=<t> peak_mb=<p>
-///   status=<s>
-/// full:    our whole report, end to end as `mobility_report --json` does it: read and load the URDF,
-/// assemble,
-///          Jacobian, self-stress basis, ordered redundancy, loops and redundant links, JSON text; the line
-///          adds load_seconds, analysis_seconds and json_bytes;
-/// literal: the lecture's algorithm, the nullity of the first k rows after each equation
-/// (ColPivHouseholderQR); dense:   one dense rank-revealing decomposition (ColPivHouseholderQR) of the same
-/// Jacobian. Peak memory is the process's maximum resident set (getrusage), so run one method per process.
+///   method=<m> file=<f> coordinates=<n> equations=<m> dof=<d> redundant=<r> seconds=<t> peak_mb=<p> status=<s>
+/// full:    our whole report, end to end as `mobility_report --json` does it: read and load the URDF, assemble,
+///          Jacobian, self-stress basis, ordered redundancy, loops and redundant links, JSON text; the line adds
+///          load_seconds, analysis_seconds and json_bytes;
+/// literal: the lecture's algorithm, the nullity of the first k rows after each equation (ColPivHouseholderQR);
+/// dense:   one dense rank-revealing decomposition (ColPivHouseholderQR) of the same Jacobian;
+/// finite:  the finite-mobility test (second-order test, step-and-project) and the passive-freedom search, timed
+///          next to the plain first-order core they follow (Jacobian, self-stress basis, ordered rank); the line
+///          has finite_dof, passive_dof, plain_seconds, finite_seconds, passive_seconds and ratio = all / plain.
+/// Peak memory is the process's maximum resident set (getrusage), so run one method per process.
 
 #include <chrono>
 #include <cstdio>
@@ -17,8 +18,8 @@
 #include <iostream>
 #include <string>
 
-#include <sys/resource.h>
 #include <Eigen/Dense>
+#include <sys/resource.h>
 
 #include "mobility_analysis/analysis/FiniteMobility.hpp"
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
@@ -48,34 +49,25 @@ int main(int argc, char** argv) {
     const std::string arg = argv[i];
     if ((arg == "--method" || arg == "--mode" || arg == "--budget") && i + 1 < argc) {
       const std::string value = argv[++i];
-      if (arg == "--method")
-        method = value;
-      if (arg == "--mode")
-        modeText = value;
-      if (arg == "--budget")
-        budget = std::stod(value);
+      if (arg == "--method") method = value;
+      if (arg == "--mode") modeText = value;
+      if (arg == "--budget") budget = std::stod(value);
     } else if (file.empty() && arg[0] != '-') {
       file = arg;
     } else {
-      return fail(
-          "usage: mobility_benchmark --method full|finite|literal|dense FILE.urdf [--mode M] [--budget S]");
+      return fail("usage: mobility_benchmark --method full|finite|literal|dense FILE.urdf [--mode M] [--budget S]");
     }
   }
   if (file.empty() || (method != "full" && method != "finite" && method != "literal" && method != "dense")) {
-    return fail(
-        "usage: mobility_benchmark --method full|finite|literal|dense FILE.urdf [--mode M] [--budget S]");
+    return fail("usage: mobility_benchmark --method full|finite|literal|dense FILE.urdf [--mode M] [--budget S]");
   }
   const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
-  if (!isOk(mode))
-    return fail(diagnosticOf(mode).toString());
+  if (!isOk(mode)) return fail(diagnosticOf(mode).toString());
   // The clock starts before the file is read: "full" is what `mobility_report --json` does, end to end.
   const auto start = std::chrono::steady_clock::now();
-  auto seconds = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
+  auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const Result<Mechanism> mechanism = loadMechanismFromFile(file);
-  if (!isOk(mechanism))
-    return fail(diagnosticOf(mechanism).toString());
+  if (!isOk(mechanism)) return fail(diagnosticOf(mechanism).toString());
   const double loadSeconds = seconds();
 
   int n = 0, m = 0, dof = -1, redundant = -1;
@@ -84,8 +76,7 @@ int main(int argc, char** argv) {
     AnalysisOptions options;
     options.mode = valueOf(mode);
     const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
-    if (!isOk(analysis))
-      return fail(diagnosticOf(analysis).toString());
+    if (!isOk(analysis)) return fail(diagnosticOf(analysis).toString());
     const MobilityReport& report = valueOf(analysis).report;
     const double analysisSeconds = seconds() - loadSeconds;
     const std::string json = toJson(report);
@@ -96,48 +87,40 @@ int main(int argc, char** argv) {
     std::printf(
         "method=full file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f load_seconds=%.4f "
         "analysis_seconds=%.4f json_bytes=%zu peak_mb=%.1f status=ok\n",
-        file.c_str(), n, m, dof, redundant, seconds(), loadSeconds, analysisSeconds, json.size(),
-        peakMegabytes());
+        file.c_str(), n, m, dof, redundant, seconds(), loadSeconds, analysisSeconds, json.size(), peakMegabytes());
     return 0;
   } else if (method == "finite") {
     // The finite-mobility and passive-freedom tests timed next to the plain first-order analysis they follow
     // (Jacobian, self-stress basis, ordered rank), all on the assembled pose.
     const Result<AssembledMechanism> assembled =
         assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
-    if (!isOk(assembled))
-      return fail(diagnosticOf(assembled).toString());
+    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
     const AssembledMechanism& a = valueOf(assembled);
-    auto now = [] { return std::chrono::steady_clock::now(); };
-    auto since = [](auto t) {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-    };
-    const auto plainStart = now();
+    auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
+    const auto plainStart = std::chrono::steady_clock::now();
     const SparseJacobian J = computeConstraintJacobian(a.model, a.q);
     const SelfStressBasis basis = computeSelfStressBasis(valueOf(mechanism), a.model, J, tolerances::kRank);
     const std::optional<OrderedRank> ranks = computeOrderedRankFromStresses(basis, tolerances::kRank);
     const OrderedRank order = ranks ? *ranks : computeOrderedRank(J, tolerances::kRank, false);
     const double plainSeconds = since(plainStart);
-    const auto finiteStart = now();
+    const auto finiteStart = std::chrono::steady_clock::now();
     const FiniteMobility finite = analyzeFiniteMobility(a.model, a.q, J, basis, order, tolerances::kRank);
     const double finiteSeconds = since(finiteStart);
-    const auto passiveStart = now();
+    const auto passiveStart = std::chrono::steady_clock::now();
     const PassiveFreedoms passive = findPassiveFreedoms(valueOf(mechanism), a.model, a.q, J);
     const double passiveSeconds = since(passiveStart);
     std::printf(
-        "method=finite file=%s coordinates=%d equations=%d dof=%d finite_dof=%d passive_dof=%d "
-        "plain_seconds=%.4f finite_seconds=%.4f passive_seconds=%.4f ratio=%.2f stepped=%d peak_mb=%.1f "
-        "status=ok\n",
-        file.c_str(), a.model.numCoordinates(), a.model.numConstraints(), order.dof(), finite.finiteDof,
-        passive.dof, plainSeconds, finiteSeconds, passiveSeconds,
-        (plainSeconds + finiteSeconds + passiveSeconds) / plainSeconds, finite.steppedAndProjected ? 1 : 0,
-        peakMegabytes());
+        "method=finite file=%s coordinates=%d equations=%d dof=%d finite_dof=%d passive_dof=%d plain_seconds=%.4f "
+        "finite_seconds=%.4f passive_seconds=%.4f ratio=%.2f stepped=%d peak_mb=%.1f status=ok\n",
+        file.c_str(), a.model.numCoordinates(), a.model.numConstraints(), order.dof(), finite.finiteDof, passive.dof,
+        plainSeconds, finiteSeconds, passiveSeconds, (plainSeconds + finiteSeconds + passiveSeconds) / plainSeconds,
+        finite.steppedAndProjected ? 1 : 0, peakMegabytes());
     return 0;
   } else {
     // The same Jacobian the full report uses, built outside the timed region for the baselines.
     const Result<AssembledMechanism> assembled =
         assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
-    if (!isOk(assembled))
-      return fail(diagnosticOf(assembled).toString());
+    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
     const SparseJacobian J = computeConstraintJacobian(valueOf(assembled).model, valueOf(assembled).q);
     n = static_cast<int>(J.cols());
     m = static_cast<int>(J.rows());
@@ -146,8 +129,7 @@ int main(int argc, char** argv) {
       status = "skipped_memory";
     } else {
       Eigen::MatrixXd dense = Eigen::MatrixXd(J);
-      for (int r = 0; r < m; ++r)
-        dense.row(r) /= dense.row(r).norm();
+      for (int r = 0; r < m; ++r) dense.row(r) /= dense.row(r).norm();
       const auto timed = std::chrono::steady_clock::now();
       if (method == "dense") {
         Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(dense);
@@ -172,16 +154,12 @@ int main(int argc, char** argv) {
         }
       }
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - timed).count();
-      std::printf(
-          "method=%s file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f peak_mb=%.1f "
-          "status=%s\n",
-          method.c_str(), file.c_str(), n, m, dof, redundant, elapsed, peakMegabytes(), status.c_str());
+      std::printf("method=%s file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f peak_mb=%.1f status=%s\n",
+                  method.c_str(), file.c_str(), n, m, dof, redundant, elapsed, peakMegabytes(), status.c_str());
       return 0;
     }
   }
-  std::printf(
-      "method=%s file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f peak_mb=%.1f "
-      "status=%s\n",
-      method.c_str(), file.c_str(), n, m, dof, redundant, seconds(), peakMegabytes(), status.c_str());
+  std::printf("method=%s file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f peak_mb=%.1f status=%s\n",
+              method.c_str(), file.c_str(), n, m, dof, redundant, seconds(), peakMegabytes(), status.c_str());
   return 0;
 }
