@@ -65,7 +65,8 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   report.rank = ranks.rank;
   // How it really moves: the second-order test over the self-stresses and a step-and-project check.
   progress("finite mobility", 0.85);
-  const FiniteMobility finite = analyzeFiniteMobility(model, analysis.assembled.q, J, basis, ranks, tolerance);
+  const FiniteMobility finite =
+      analyzeFiniteMobility(model, analysis.assembled.q, J, basis, ranks, tolerance);
   report.finiteDof = finite.finiteDof;
   report.singular = finite.singular;
   // Idle groups' motions (Tsai): a rod spinning between two balls, a link sliding between parallel slides.
@@ -130,7 +131,8 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   progress("redundant links", 0.9);
   std::vector<bool> linkInLoop, jointInLoop;
   findOverConstrainedLoops(mechanism, model, finite.structuralStresses, linkInLoop, jointInLoop);
-  const std::vector<bool> linkRedundant = findRedundantLinks(mechanism, model, finite.structuralStresses, tolerance);
+  const std::vector<bool> linkRedundant =
+      findRedundantLinks(mechanism, model, finite.structuralStresses, tolerance);
   report.redundantLinksComputed = true;
   for (size_t l = 0; l < mechanism.links.size(); ++l) {
     if (linkRedundant[l])

@@ -138,10 +138,12 @@ std::string toText(const MobilityReport& r) {
   out << "  degrees of freedom (nullity of the constraint Jacobian): " << r.dof << "\n";
   out << "  Grubler-Kutzbach count:                                  " << r.grublerKutzbachDof << "\n";
   out << "  finite DOF (how it really moves near this pose):          " << r.finiteDof
-      << (r.singular ? "  SINGULAR pose: the nullity counts first-order freedom the mechanism does not have" : "")
+      << (r.singular ? "  SINGULAR pose: the nullity counts first-order freedom the mechanism does not have"
+                     : "")
       << "\n";
   out << "  passive DOF (idle groups) " << r.passiveDof << ", output DOF " << r.outputDof << "\n";
-  for (const PassiveMotion& m : r.passiveMotions) out << "    passive: " << m.description << "\n";
+  for (const PassiveMotion& m : r.passiveMotions)
+    out << "    passive: " << m.description << "\n";
   out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints << ", rank "
       << r.rank << "\n";
   out << "  redundant equations: " << r.numRedundant << " (= dof - Grubler = " << r.dof - r.grublerKutzbachDof
@@ -151,7 +153,8 @@ std::string toText(const MobilityReport& r) {
   }
   for (const RedundantConstraint& c : r.redundantConstraints) {
     out << "      #" << c.index << " [" << c.source << " " << c.name << ", " << c.kind << "] " << c.equation
-        << (c.cause == "configuration" ? "  (cause: configuration, only this pose makes it dependent)" : "") << "\n";
+        << (c.cause == "configuration" ? "  (cause: configuration, only this pose makes it dependent)" : "")
+        << "\n";
   }
   out << "  redundant links: ";
   if (!r.redundantLinksComputed) {

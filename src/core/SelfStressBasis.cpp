@@ -234,7 +234,8 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
   basis.rank = elimination.rank();
   basis.smallestKeptPivot = elimination.smallestKeptPivot();
   basis.largestDroppedResidual = elimination.largestDroppedResidual();
-  if (std::optional<std::vector<Eigen::VectorXd>> motions = elimination.nullSpace(SelfStressBasis::kMaxMotions)) {
+  if (std::optional<std::vector<Eigen::VectorXd>> motions =
+          elimination.nullSpace(SelfStressBasis::kMaxMotions)) {
     basis.motions = std::move(*motions);
     basis.motionsComputed = true;
   }

@@ -436,15 +436,19 @@ namespace mobility_analysis {
 
 MechanismDescription makeFlattenedFourBar() {
   // Change-point four-bar: crank + coupler = ground + rocker (0.4 + 0.9 = 1.0 + 0.3), drawn flat.
-  const Eigen::Vector3d a = planar(0.0, 0.0), b = planar(0.4, 0.0), c = planar(1.3, 0.0), d = planar(1.0, 0.0);
+  const Eigen::Vector3d a = planar(0.0, 0.0), b = planar(0.4, 0.0), c = planar(1.3, 0.0),
+                        d = planar(1.0, 0.0);
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   MechanismDescription m;
   m.name = "flattened_four_bar";
   m.comment =
-      "Four-bar drawn flat: ground A(0,0)-D(1,0), crank AB 0.4, coupler BC 0.9, rocker CD 0.3 [m], all pins on\n"
+      "Four-bar drawn flat: ground A(0,0)-D(1,0), crank AB 0.4, coupler BC 0.9, rocker CD 0.3 [m], all pins "
+      "on\n"
       "the x axis (B = (0.4,0), C = (1.3,0)). crank + coupler = ground + rocker (1.3 = 1.3): a change-point\n"
-      "four-bar, and the flat pose is where its two branches cross. First order: DOF 2 (the nullity), Gruebler 1,\n"
-      "1 redundant equation; the mechanism moves along either branch with 1 DOF: finite_dof 1, singular, and\n"
+      "four-bar, and the flat pose is where its two branches cross. First order: DOF 2 (the nullity), "
+      "Gruebler 1,\n"
+      "1 redundant equation; the mechanism moves along either branch with 1 DOF: finite_dof 1, singular, "
+      "and\n"
       "the redundancy's cause is the configuration.";
   m.links = {link("ground", {a, d}), link("crank", {a, b}), link("coupler", {b, c}), link("rocker", {c, d})};
   m.connections = {makeRevolute("ground_crank", "ground", "crank", a, z),
@@ -456,14 +460,17 @@ MechanismDescription makeFlattenedFourBar() {
 }
 
 MechanismDescription makeParallelogramBifurcation() {
-  const Eigen::Vector3d a = planar(0.0, 0.0), b = planar(0.5, 0.0), c = planar(1.5, 0.0), d = planar(1.0, 0.0);
+  const Eigen::Vector3d a = planar(0.0, 0.0), b = planar(0.5, 0.0), c = planar(1.5, 0.0),
+                        d = planar(1.0, 0.0);
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   MechanismDescription m;
   m.name = "parallelogram_bifurcation";
   m.comment =
       "Parallelogram four-bar at its bifurcation pose: ground A(0,0)-D(1,0), cranks AB = DC = 0.5, coupler\n"
-      "BC = 1 [m], both cranks along +x (B = (0.5,0), C = (1.5,0)), all pins collinear. Here the parallelogram\n"
-      "branch and the anti-parallelogram branch cross. First order: DOF 2, Gruebler 1, 1 redundant equation;\n"
+      "BC = 1 [m], both cranks along +x (B = (0.5,0), C = (1.5,0)), all pins collinear. Here the "
+      "parallelogram\n"
+      "branch and the anti-parallelogram branch cross. First order: DOF 2, Gruebler 1, 1 redundant "
+      "equation;\n"
       "finite_dof 1, singular, cause configuration.";
   m.links = {link("ground", {a, d}), link("crank1", {a, b}), link("coupler", {b, c}), link("crank2", {c, d})};
   m.connections = {makeRevolute("ground_crank1", "ground", "crank1", a, z),
@@ -481,7 +488,8 @@ MechanismDescription makeCollinearBars() {
   m.name = "collinear_bars";
   m.comment =
       "Two equal bars collinear between two ground pins: A(0,0) and C(1,0) on the ground, bar1 A-B and bar2\n"
-      "B-C of 0.5 m, B = (0.5,0) [m]. Gruebler 3 (3 - 1) - 3 * 2 = 0: a structure. B may move across the line\n"
+      "B-C of 0.5 m, B = (0.5,0) [m]. Gruebler 3 (3 - 1) - 3 * 2 = 0: a structure. B may move across the "
+      "line\n"
       "to first order (DOF 1, 1 redundant equation), but not at all in fact: finite_dof 0, singular, cause\n"
       "configuration (the classic example of a first-order infinitesimal mechanism).";
   m.links = {link("ground", {a, c}), link("bar1", {a, b}), link("bar2", {b, c})};
@@ -499,10 +507,13 @@ MechanismDescription makeStewart6Sps() {
   m.name = "stewart_6sps";
   m.comment =
       "Stewart-Gough platform, 6-SPS. Base ball joints B_i at radius 1 m, angles 120k -15 and 120k +15 deg\n"
-      "(k = 0, 1, 2); platform ball joints P_i at radius 0.5 m, height 1 m, angles 120k - 45 and 120k + 45 deg;\n"
-      "leg i runs from B_i to P_i: a cylinder (ball at B_i) and a piston (ball at P_i) joined by a prismatic\n"
+      "(k = 0, 1, 2); platform ball joints P_i at radius 0.5 m, height 1 m, angles 120k - 45 and 120k + 45 "
+      "deg;\n"
+      "leg i runs from B_i to P_i: a cylinder (ball at B_i) and a piston (ball at P_i) joined by a "
+      "prismatic\n"
       "joint along the leg at its midpoint. Cylinders, pistons' parents and the platform hang by floating\n"
-      "joints. Gruebler 6 (14 - 18 - 1) + 6 (3 + 1 + 3) = 12 = DOF: the platform's 6 and each leg's spin about\n"
+      "joints. Gruebler 6 (14 - 18 - 1) + 6 (3 + 1 + 3) = 12 = DOF: the platform's 6 and each leg's spin "
+      "about\n"
       "its own line (Tsai 1999: passive), so passive_dof 6, output_dof 6.";
   std::vector<Eigen::Vector3d> base, top;
   for (int k = 0; k < 3; ++k) {
@@ -548,7 +559,8 @@ MechanismDescription makeDeltaRobot() {
       "ground revolute at radius 0.2 m about the tangent t_i, arm 0.2 m long pointing out and 30 deg down;\n"
       "two balls at the arm's end E_i +- 0.03 t_i and two on the platform at C + 0.05 u_i +- 0.03 t_i with\n"
       "C = (0, 0, -0.35) m; each of the two rods of an arm joins a pair (the rods of an arm are equal and\n"
-      "parallel: a parallelogram). Rods and platform hang by floating joints. Gruebler 6 (11 - 15 - 1) + 3 + 36\n"
+      "parallel: a parallelogram). Rods and platform hang by floating joints. Gruebler 6 (11 - 15 - 1) + 3 + "
+      "36\n"
       "= 9 = DOF: the platform's 3 translations and each rod's spin about its own line (passive_dof 6,\n"
       "output_dof 3).";
   LinkDescription platform = link("platform");
