@@ -123,6 +123,10 @@ std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const
  * every other element a linear combination of them (3 or 2 equations each), so each body keeps exactly
  * lambda freedoms. Joints: the primitives of their JointTypeSpec row. Boundary: the ground's lambda rigid
  * freedoms fixed. Hence num_coordinates - num_constraints equals the Grübler count.
+ * @note The phases (elements at joints, body bases, coordinate order, rigid-link, joint and boundary
+ * equations) live one per file under src/core/coordinates/ (coordinates/ModelBuilder.hpp); a joint type's
+ * equations are its JointTypeSpec row's primitives, written in JointEquations.cpp, with their algebra (value,
+ * gradient, Hessian) in coordinates/EquationForms.hpp.
  * @param[in] mechanism the mechanism.
  * @param[in] poses link poses at which the loops close (or nearly: the assembly's starting point).
  * @param[in] mode Auto, Planar or Spatial.
