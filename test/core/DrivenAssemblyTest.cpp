@@ -185,3 +185,53 @@ TEST(DrivenAssembly, UnknownOrMultiFreedomJointIsRefused) {
   ASSERT_FALSE(isOk(loop));
   EXPECT_EQ(diagnosticOf(loop).elementName, "j4");
 }
+
+TEST(DrivenAssembly, SphericalFourBarHoldsItsCrankAndFollowsTheConeIntersection) {
+  // test/fixtures/motion/spherical_4r.urdf: u1 = z, u4 = (sin 70, 0, cos 70), crank arc 30 deg written at
+  // azimuth 90 deg, coupler and rocker arcs 60 deg; u3 lies on the cones of 60 deg about u2 and u4, on the
+  // side of u2 x u4.
+  const Mechanism mechanism = loadOrFail(motionFixture("spherical_4r.urdf"));
+  const double deg = M_PI / 180.0;
+  const Eigen::Vector3d u4(std::sin(70 * deg), 0.0, std::cos(70 * deg));
+  for (const double j1 : {0.6, -0.8, 1.5}) {
+    SCOPED_TRACE(j1);
+    const MobilityAnalysis a = drive(motionFixture("spherical_4r.urdf"), {{"j1", j1}});
+    EXPECT_EQ(reported(a.report, "j1"), j1);
+    const double azimuth = 90 * deg + j1;
+    const Eigen::Vector3d u2(std::sin(30 * deg) * std::cos(azimuth), std::sin(30 * deg) * std::sin(azimuth),
+                             std::cos(30 * deg));
+    const double c = std::cos(60 * deg), c24 = u2.dot(u4);
+    const double p = (c - c * c24) / (1 - c24 * c24), q = (c - c * c24) / (1 - c24 * c24);
+    const Eigen::Vector3d base = p * u2 + q * u4;
+    const Eigen::Vector3d u3 = base + std::sqrt(1.0 - base.squaredNorm()) * u2.cross(u4).normalized();
+    const Eigen::Vector3d reached = a.assembled.poses[*mechanism.findLink("rocker")].linear().col(2);
+    EXPECT_NEAR((reached - u3).norm(), 0.0, 1e-9) << reached.transpose() << " vs " << u3.transpose();
+    EXPECT_LE(a.report.assembly.residual, 1e-12 * a.report.characteristicLength);
+  }
+}
+
+TEST(DrivenAssembly, StewartLegsDrivenReachTheirLengths) {
+  // Every leg is a lower and an upper link on a prismatic joint between two balls: after driving slide i by
+  // s_i the ball centres are L_i + s_i apart (L_i as written), whatever the platform does.
+  const Mechanism mechanism = loadOrFail(motionFixture("stewart_6sps.urdf"));
+  const LinkPoses written = computeTreePoses(mechanism, {});
+  auto legLength = [&](const LinkPoses& poses, int leg) {
+    const Joint& base = mechanism.joints[*mechanism.findJoint("ball" + std::to_string(leg) + "_base")];
+    const Joint& top = mechanism.joints[*mechanism.findJoint("ball" + std::to_string(leg) + "_top")];
+    return ((poses[base.link2] * base.frame2.translation()) - (poses[top.link2] * top.frame2.translation()))
+        .norm();
+  };
+  const JointPositions slides = {{"slide1", 0.03}, {"slide2", -0.02}, {"slide3", 0.05},
+                                 {"slide4", 0.01}, {"slide5", -0.04}, {"slide6", 0.02}};
+  const MobilityAnalysis all = drive(motionFixture("stewart_6sps.urdf"), slides);
+  for (int leg = 1; leg <= 6; ++leg) {
+    const double s = slides.at("slide" + std::to_string(leg));
+    EXPECT_NEAR(reported(all.report, "slide" + std::to_string(leg)), s, 1e-12);
+    EXPECT_NEAR(legLength(all.assembled.poses, leg), legLength(written, leg) + s, 1e-9) << leg;
+  }
+  EXPECT_EQ(all.report.dof, 12);
+  // One leg alone is held as asked too (the platform follows by least change).
+  const MobilityAnalysis one = drive(motionFixture("stewart_6sps.urdf"), {{"slide1", 0.03}});
+  EXPECT_EQ(reported(one.report, "slide1"), 0.03);
+  EXPECT_NEAR(legLength(one.assembled.poses, 1), legLength(written, 1) + 0.03, 1e-9);
+}
