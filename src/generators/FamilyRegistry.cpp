@@ -60,6 +60,7 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"bricard", 0, 0, "bricard", "line-symmetric Bricard 6R; spatial DOF 1 G 0 R 1"},
       {"goldberg", 0, 0, "goldberg", "Goldberg 5R; spatial DOF 1 G -1 R 2"},
       {"rssr", 0, 0, "rssr", "RSSR, rod floating; spatial DOF 2 G 2 R 0"},
+      {"peaucellier", 0, 0, "peaucellier", "Peaucellier-Lipkin straight-line linkage; planar DOF 1 G 1 R 0"},
       {"sle_mast", 0, 0, "sle_mast", "= sle_planar 4"},
       {"hoberman_ring", 0, 0, "hoberman_ring", "= hoberman 6"},
       {"door", 0, 1, "door [K=3]",
@@ -159,6 +160,8 @@ GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& r
     mechanism = makeGoldberg();
   } else if (family == "rssr") {
     mechanism = makeRssr();
+  } else if (family == "peaucellier") {
+    mechanism = makePeaucellier();
   } else if (family == "sle_mast") {
     mechanism = makeSlePlanarMast(4);
     mechanism.name = "sle_mast";
