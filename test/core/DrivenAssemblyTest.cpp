@@ -235,3 +235,32 @@ TEST(DrivenAssembly, StewartLegsDrivenReachTheirLengths) {
   EXPECT_EQ(reported(one.report, "slide1"), 0.03);
   EXPECT_NEAR(legLength(one.assembled.poses, 1), legLength(written, 1) + 0.03, 1e-9);
 }
+
+TEST(DrivenAssembly, PeaucellierDrivenTwentyDegreesStaysAnInversor) {
+  // urdf/peaucellier.urdf: O = 0, A = (1, 0), crank AP 1, arms OB = OD = 3, rhombus side 1.5, written at a
+  // crank angle of 30 deg with B on the left of O -> P. In its assembly mode O, P, Q are collinear, |OP| |OQ|
+  // = 3^2 - 1.5^2 and Q runs on the line x = 3.375; the folded modes (B = D, or Q = P) break all three.
+  const Mechanism mechanism = loadOrFail(urdfPath("peaucellier.urdf"));
+  const Joint& bqdq = mechanism.joints[*mechanism.findJoint("bq_dq")];
+  for (const double degrees : {20.0, -20.0}) {
+    SCOPED_TRACE(degrees);
+    const double target = degrees * M_PI / 180.0;
+    const MobilityAnalysis a = drive(urdfPath("peaucellier.urdf"), {{"a_crank", target}});
+    EXPECT_EQ(reported(a.report, "a_crank"), target);
+    const LinkPoses& poses = a.assembled.poses;
+    const Eigen::Vector3d p = poses[*mechanism.findLink("pb")].translation();
+    const Eigen::Vector3d b = poses[*mechanism.findLink("bq")].translation();
+    const Eigen::Vector3d d = poses[*mechanism.findLink("dq")].translation();
+    const Eigen::Vector3d q = (poses[bqdq.link1] * bqdq.frame1).translation();
+    // P where the crank puts it: the angle is held.
+    const double crank = 30.0 * M_PI / 180.0 + target;
+    EXPECT_NEAR((p - Eigen::Vector3d(1.0 + std::cos(crank), std::sin(crank), 0.0)).norm(), 0.0, 1e-9);
+    EXPECT_NEAR(p.norm() * q.norm(), 6.75, 1e-9);
+    EXPECT_NEAR(q.x(), 3.375, 1e-9);
+    EXPECT_NEAR(p.cross(q).norm(), 0.0, 1e-9);  // O, P, Q collinear
+    EXPECT_GT(p.cross(b).z(), 0.1);             // B still on the left of O -> P
+    EXPECT_LT(p.cross(d).z(), -0.1);            // D on the right: the rhombus is not folded
+    EXPECT_EQ(a.report.dof, 1);
+    EXPECT_LE(a.report.assembly.residual, 1e-12 * a.report.characteristicLength);
+  }
+}
