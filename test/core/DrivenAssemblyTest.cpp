@@ -1,9 +1,14 @@
 #include "mobility_analysis/motion/DrivenAssembly.hpp"
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include "core/TestModels.hpp"
 
@@ -263,4 +268,45 @@ TEST(DrivenAssembly, PeaucellierDrivenTwentyDegreesStaysAnInversor) {
     EXPECT_EQ(a.report.dof, 1);
     EXPECT_LE(a.report.assembly.residual, 1e-12 * a.report.characteristicLength);
   }
+}
+
+namespace {
+
+struct CliRun {
+  int status;
+  std::string out, err;
+};
+
+CliRun runReport(const std::string& arguments) {
+  const std::string errFile = ::testing::TempDir() + "driven_mobility_report_stderr.txt";
+  const std::string command = std::string(MA_REPORT_EXE) + " " + arguments + " 2>" + errFile;
+  CliRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.out.append(buffer.data(), n);
+  run.status = WEXITSTATUS(pclose(pipe));
+  std::ifstream err(errFile);
+  std::stringstream text;
+  text << err.rdbuf();
+  run.err = text.str();
+  return run;
+}
+
+}  // namespace
+
+TEST(DrivenAssemblyCli, TextReportSaysWhereItEndedAndUnreachableValuesExitTwo) {
+  const CliRun moved = runReport(motionFixture("crank_rocker.urdf") + " --positions j1=2");
+  EXPECT_EQ(moved.status, 0) << moved.err;
+  EXPECT_NE(moved.out.find("positions reached [rad or m]: j1 2,"), std::string::npos) << moved.out;
+  EXPECT_NE(moved.out.find("continuation steps"), std::string::npos) << moved.out;
+  const CliRun json = runReport(motionFixture("crank_rocker.urdf") + " --positions j1=2 --json");
+  EXPECT_NE(json.out.find("\"positions\": {\"j1\": 2,"), std::string::npos) << json.out;
+
+  const CliRun beyond = runReport(motionFixture("crank_rocker.urdf") + " --positions j3=3");
+  EXPECT_EQ(beyond.status, 2);
+  EXPECT_TRUE(beyond.out.empty()) << beyond.out;
+  EXPECT_EQ(std::count(beyond.err.begin(), beyond.err.end(), '\n'), 1) << beyond.err;
+  EXPECT_NE(beyond.err.find("'j3': 3 rad cannot be reached"), std::string::npos) << beyond.err;
 }
