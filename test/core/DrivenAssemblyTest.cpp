@@ -310,3 +310,22 @@ TEST(DrivenAssemblyCli, TextReportSaysWhereItEndedAndUnreachableValuesExitTwo) {
   EXPECT_EQ(std::count(beyond.err.begin(), beyond.err.end(), '\n'), 1) << beyond.err;
   EXPECT_NE(beyond.err.find("'j3': 3 rad cannot be reached"), std::string::npos) << beyond.err;
 }
+
+TEST(DrivenAssembly, ParallelogramCrossesItsBranchPointOnItsOwnBranchAndSaysSo) {
+  // test/fixtures/motion/parallelogram.urdf, written at crank angle 60 deg: at 180 deg (j1 = 2 pi / 3) all
+  // pins are collinear and the anti-parallelogram branch crosses. On the parallelogram branch the coupler
+  // keeps its direction (j2 = -j1) and the rocker turns with the crank (j3 = j1).
+  const MobilityAnalysis a = drive(motionFixture("parallelogram.urdf"), {{"j1", 3.0}});
+  EXPECT_EQ(reported(a.report, "j1"), 3.0);
+  EXPECT_NEAR(reported(a.report, "j2"), -3.0, 1e-9);
+  EXPECT_NEAR(reported(a.report, "j3"), 3.0, 1e-9);
+  ASSERT_EQ(a.report.assembly.events.size(), 1u);
+  const std::string& event = a.report.assembly.events.front();
+  EXPECT_EQ(event.find("branch point"), 0u) << event;
+  const size_t at = event.find("j1 = ");
+  ASSERT_NE(at, std::string::npos) << event;
+  EXPECT_NEAR(std::strtod(event.c_str() + at + 5, nullptr), 2.0 * M_PI / 3.0, tolerances::kContinuationStep)
+      << event;
+  // A motion that stays away from it meets nothing.
+  EXPECT_TRUE(drive(motionFixture("parallelogram.urdf"), {{"j1", 1.0}}).report.assembly.events.empty());
+}

@@ -58,6 +58,14 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
   LinkPoses poses = posesOf(mechanism, layout, configuration);
   Eigen::VectorXd r, trialR, step;
   Eigen::SparseMatrix<double> J;
+  // Closed already (the usual case for a written or previous pose): no Jacobian, whose rows walk the tree
+  // paths of every loop (long on deep trees such as a mast written as one chain).
+  evaluateClosure(mechanism, layout, poses, columns, numColumns, r, nullptr);
+  if (maxAbs(r) <= tolerances::kAssemblyTarget) {
+    result.residual = maxAbs(r);
+    result.converged = true;
+    return result;
+  }
   evaluateClosure(mechanism, layout, poses, columns, numColumns, r, &J);
   double cost = r.squaredNorm();
   double mu = -1.0, nu = 2.0;
