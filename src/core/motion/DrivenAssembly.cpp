@@ -179,6 +179,10 @@ Result<DrivenMotion> followDrivenPositions(const Mechanism& mechanism, const Lin
   double h = span > 0.0 ? std::min(1.0, maxStep / span) : 1.0;
   const double hMin = span > 0.0 ? 1e-10 / span : 1.0;
   Eigen::VectorXd tangent, change;
+  // Steps creep near a singular point (the tangent grows without bound); past this many tries the motion is
+  // reported as stopped there.
+  constexpr int kMaxAttempts = 100000;
+  int attempts = 0;
   while (s < 1.0 && span > 0.0) {
     h = std::min(h, 1.0 - s);
     // Predictor: the least-change motion of the free joints that keeps the loops closed to first order.
@@ -194,7 +198,7 @@ Result<DrivenMotion> followDrivenPositions(const Mechanism& mechanism, const Lin
       h = std::max(maxStep / freeSpeed, hMin * 0.5);
     bool accepted = false;
     while (!accepted) {
-      if (h < hMin) {
+      if (h < hMin || ++attempts > kMaxAttempts) {
         // The target lies beyond a dead point of this assembly mode (or the drivers contradict each other).
         const Driver* worst = &drivers.front();
         for (const Driver& d : drivers)
