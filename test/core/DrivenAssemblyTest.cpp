@@ -268,6 +268,16 @@ TEST(DrivenAssembly, PeaucellierDrivenTwentyDegreesStaysAnInversor) {
     EXPECT_EQ(a.report.dof, 1);
     EXPECT_LE(a.report.assembly.residual, 1e-12 * a.report.characteristicLength);
   }
+  // |OP| = 2 cos(crank / 2) cannot fall below arm - side = 1.5: the crank stops at 2 acos(0.75) = 82.8 deg.
+  AnalysisOptions options;
+  options.positions = {{"a_crank", 1.0}};
+  const Result<MobilityAnalysis> beyond = analyzeMechanism(mechanism, options);
+  ASSERT_FALSE(isOk(beyond));
+  EXPECT_EQ(diagnosticOf(beyond).elementName, "a_crank");
+  const std::string& what = diagnosticOf(beyond).what;
+  const size_t at = what.find("stops at ");
+  ASSERT_NE(at, std::string::npos) << what;
+  EXPECT_NEAR(std::strtod(what.c_str() + at + 9, nullptr), 2.0 * std::acos(0.75) - M_PI / 6.0, 1e-4) << what;
 }
 
 namespace {
