@@ -1,5 +1,8 @@
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "mobility_analysis/Diagnostic.hpp"
 #include "mobility_analysis/NaturalCoordinates.hpp"
 
@@ -7,23 +10,34 @@ namespace mobility_analysis {
 
 /// A model whose loops are closed, with the coordinates and link poses that close them.
 struct AssembledMechanism {
-  CoordinateModel model;      ///< Built at the assembled pose.
-  Eigen::VectorXd q;          ///< Coordinates that satisfy Phi(q) = 0 (dim num_coordinates).
-  LinkPoses poses;            ///< Link poses in the root frame.
-  double initialResidual = 0.0;  ///< max |Phi| before assembly [m].
-  double finalResidual = 0.0;    ///< max |Phi| after assembly [m].
-  int iterations = 0;            ///< Newton iterations used.
+  CoordinateModel model;            ///< Built at the assembled pose.
+  Eigen::VectorXd q;                ///< Coordinates that satisfy Phi(q) = 0 (dim num_coordinates).
+  LinkPoses poses;                  ///< Link poses in the root frame.
+  double initialResidual = 0.0;     ///< Largest loop residual before assembly [m] (angles times Lc).
+  double finalResidual = 0.0;       ///< max |Phi| of the analysis model after assembly [m].
+  int iterations = 0;               ///< Levenberg–Marquardt iterations, restarts and continuation included.
+  int restarts = 0;                 ///< Restarts the closure needed (0: closed from the start pose).
+  int steps = 0;                    ///< Continuation steps towards driven positions (0 without).
+  JointPositions positions;         ///< Every 1-DOF tree joint's value; driven ones exactly as asked.
+  std::vector<std::string> events;  ///< Branch or dead points met on the way to driven positions.
 };
 
 /**
- * @brief Closes the loops from @p startPoses by Newton's method with least change, then builds the model there.
+ * @brief Closes the loops from @p startPoses (holding @p driven joints at their values, reached by
+ *        continuation), then builds the model for @p mode there.
  *
- * Always in spatial coordinates (every joint equation holds in 3-D); the model for @p mode is built at the
- * result. Each step is the minimum-norm solution of \f$ \Phi_q \Delta q = -\Phi \f$ (damped, so redundant
- * equations are harmless when consistent).
- * @return The assembled mechanism, or a Diagnostic naming the loop element with the largest residual.
+ * The closure works in tree coordinates (motion/LoopClosure.hpp): the tree joints hold by construction, the
+ * loop-closing connections are residuals written as differences of frames (so a revolute or weld cannot close
+ * on an axis turned by 180°), and a Levenberg–Marquardt solver with restarts brings them to
+ * tolerances::kAssemblyTarget (normalised). With @p driven values, followDrivenPositions
+ * (motion/DrivenAssembly.hpp) moves the mechanism there on the start's assembly mode. The analysis model is
+ * then built at the closed poses and checked.
+ * @param[in] startPoses the written pose or the previous state; distance constraints take their lengths here.
+ * @param[in] driven driven tree-joint values [rad] or [m]; empty: close from the start pose only.
+ * @return The assembled mechanism, or a Diagnostic naming the loop element (residual and pose reached) or the
+ *         driven joint that cannot reach its value.
  */
 Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const LinkPoses& startPoses,
-                                             AnalysisMode mode);
+                                             AnalysisMode mode, const JointPositions& driven = {});
 
 }  // namespace mobility_analysis

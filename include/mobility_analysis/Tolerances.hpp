@@ -26,6 +26,16 @@ constexpr double kClosure = 1e-9;
 /// Maximum Newton iterations of the assembly.
 constexpr int kAssemblyMaxIterations = 50;
 
+/// The assembly closes the loops to this largest residual [normalised length / rad]; a model that
+/// cannot reach it from its pose and from any restart cannot be closed.
+constexpr double kAssemblyTarget = 1e-12;
+
+/// Levenberg–Marquardt iterations of one closure attempt (from the pose or from one restart).
+constexpr int kClosureMaxIterations = 200;
+
+/// Continuation towards driven positions: the largest change of any joint per step [rad] or [Lc].
+constexpr double kContinuationStep = 0.05;
+
 /// A loop residual above this after assembly means the loop cannot be closed [normalised length].
 constexpr double kAssemblyFailure = 1e-6;
 

@@ -30,9 +30,11 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
       options.progress(phase, fraction);
   };
   progress("assembly", 0.0);
+  // Driven positions are held exactly and reached by continuation from the start (the previous state, else
+  // the written pose), so the mechanism stays in the start's assembly mode (motion/DrivenAssembly.hpp).
   Result<AssembledMechanism> assembled =
-      assembleMechanism(mechanism, options.startPoses ? *options.startPoses : computeTreePoses(mechanism, options.positions),
-                        options.mode);
+      assembleMechanism(mechanism, options.startPoses ? *options.startPoses : computeTreePoses(mechanism, {}),
+                        options.mode, options.positions);
   if (!isOk(assembled))
     return diagnosticOf(assembled);
   MobilityAnalysis analysis;
@@ -78,14 +80,16 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   report.characteristicLength = model.characteristicLength;
   report.closureResidualBefore = analysis.assembled.initialResidual;
   report.closureResidualAfter = analysis.assembled.finalResidual;
-  const JointPositions reached = computeJointPositions(mechanism, analysis.assembled.poses, options.positions);
+  const JointPositions& reached = analysis.assembled.positions;
   for (const Joint& joint : mechanism.joints) {
     const auto value = reached.find(joint.name);
     if (joint.kind == ConnectionKind::TreeJoint && value != reached.end())
       report.positions.push_back(JointValue{joint.name, value->second});
   }
   report.assembly.residual = analysis.assembled.finalResidual;
+  report.assembly.steps = analysis.assembled.steps;
   report.assembly.iterations = analysis.assembled.iterations;
+  report.assembly.events = analysis.assembled.events;
   report.rankMargin.tolerance = tolerance;
   report.rankMargin.smallestKeptPivot = ranks.smallestKeptPivot;
   report.rankMargin.largestDroppedResidual = ranks.largestDroppedResidual;

@@ -190,6 +190,20 @@ std::string toText(const MobilityReport& r) {
   out << "  lengths in Lc = " << number(r.characteristicLength, 6) << " m; loop closure residual "
       << number(r.closureResidualBefore, 3) << " m before assembly, " << number(r.closureResidualAfter, 3)
       << " m after\n";
+  // Where the mechanism is (driven joints exactly at their values) and how it got there.
+  if (!r.positions.empty()) {
+    constexpr size_t kShown = 12;
+    out << "  positions reached [rad or m]:";
+    for (size_t i = 0; i < r.positions.size() && i < kShown; ++i)
+      out << (i ? ", " : " ") << r.positions[i].name << " " << number(r.positions[i].value, 9);
+    if (r.positions.size() > kShown) out << ", ... (" << r.positions.size() - kShown << " more in --json)";
+    out << "\n";
+  }
+  out << "  assembly: residual " << number(r.assembly.residual, 3) << " m, " << r.assembly.steps
+      << " continuation steps, " << r.assembly.iterations << " iterations; events: ";
+  if (r.assembly.events.empty()) out << "none";
+  for (size_t i = 0; i < r.assembly.events.size(); ++i) out << (i ? "; " : "") << r.assembly.events[i];
+  out << "\n";
   return out.str();
 }
 

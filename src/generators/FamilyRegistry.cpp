@@ -69,6 +69,7 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"stewart_6sps", 0, 0, "stewart_6sps", "Stewart-Gough 6-SPS; spatial DOF 12 (passive 6) G 12 R 0"},
       {"delta_robot", 0, 0, "delta_robot",
        "Delta, ball-jointed parallelogram rods; spatial DOF 9 (passive 6)"},
+      {"peaucellier", 0, 0, "peaucellier", "Peaucellier-Lipkin straight-line linkage; planar DOF 1 G 1 R 0"},
       {"sle_mast", 0, 0, "sle_mast", "= sle_planar 4"},
       {"hoberman_ring", 0, 0, "hoberman_ring", "= hoberman 6"},
       {"door", 0, 1, "door [K=3]",
@@ -178,6 +179,8 @@ GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& r
     mechanism = makeStewart6Sps();
   } else if (family == "delta_robot") {
     mechanism = makeDeltaRobot();
+  } else if (family == "peaucellier") {
+    mechanism = makePeaucellier();
   } else if (family == "sle_mast") {
     mechanism = makeSlePlanarMast(4);
     mechanism.name = "sle_mast";

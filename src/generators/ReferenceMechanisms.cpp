@@ -430,6 +430,43 @@ MechanismDescription makeRssr() {
   return m;
 }
 
+MechanismDescription makePeaucellier(double crankAngle) {
+  const double r = 1.0, arm = 3.0, side = 1.5;
+  const Eigen::Vector2d o(0.0, 0.0), a(r, 0.0);
+  const Eigen::Vector2d p = a + r * Eigen::Vector2d(std::cos(crankAngle), std::sin(crankAngle));
+  const Eigen::Vector2d b = intersectCircles(o, arm, p, side, true);
+  const Eigen::Vector2d d = intersectCircles(o, arm, p, side, false);
+  const Eigen::Vector2d q = b + d - p;  // the rhombus' fourth corner
+  assert(std::abs(p.norm() * q.norm() - (arm * arm - side * side)) < 1e-12 && "inversion does not hold");
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  auto v = [](const Eigen::Vector2d& w) { return planar(w.x(), w.y()); };
+
+  MechanismDescription m;
+  m.name = "peaucellier";
+  m.comment =
+      "Peaucellier-Lipkin straight-line linkage (Peaucellier 1864, Lipkin 1871; the inversor\n"
+      "cell as in Hartenberg & Denavit, Kinematic Synthesis of Linkages, 1964), our own numbers,\n"
+      "in the x-y plane, axes along z: ground pivots O(0,0) and A(1,0), crank AP 1 (so P runs on\n"
+      "a circle through O), arms OB = OD = 3, rhombus PB = BQ = QD = DP = 1.5 [m]. O, P, Q are\n"
+      "collinear with |OP| |OQ| = 3^2 - 1.5^2 = 6.75, so Q runs on the line x = 6.75 / 2 = 3.375.\n"
+      "Written at crank angle " +
+      std::to_string(crankAngle / kDeg) +
+      " deg, B on the left of O->P, D on the right.\nLoops closed by loop joints pb_arm1, pd_arm2, bq_dq. "
+      "Planar DOF 1.";
+  m.links = {link("ground", {v(o), v(a)}), link("crank", {v(a), v(p)}), link("arm1", {v(o), v(b)}),
+             link("arm2", {v(o), v(d)}),   link("pb", {v(p), v(b)}),    link("pd", {v(p), v(d)}),
+             link("bq", {v(b), v(q)}),     link("dq", {v(d), v(q)})};
+  m.connections = {
+      makeRevolute("a_crank", "ground", "crank", v(a), z), makeRevolute("o_arm1", "ground", "arm1", v(o), z),
+      makeRevolute("o_arm2", "ground", "arm2", v(o), z),   makeRevolute("crank_pb", "crank", "pb", v(p), z),
+      makeRevolute("crank_pd", "crank", "pd", v(p), z),    makeRevolute("arm1_bq", "arm1", "bq", v(b), z),
+      makeRevolute("arm2_dq", "arm2", "dq", v(d), z),      makeRevolute("pb_arm1", "pb", "arm1", v(b), z),
+      makeRevolute("pd_arm2", "pd", "arm2", v(d), z),      makeRevolute("bq_dq", "bq", "dq", v(q), z)};
+  m.visualRadius = 0.03;
+  m.expectations = {expectation("planar", 1, 1), expectation("spatial", 1, -8)};
+  return m;
+}
+
 }  // namespace mobility_analysis
 
 namespace mobility_analysis {

@@ -1,6 +1,6 @@
 /// mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] [--rank-tolerance T]
-/// [--json] Prints the mobility report of a closed-loop URDF; on bad input one line on stderr and exit
-/// code 2.
+/// [--json] Prints the mobility report of a closed-loop URDF, with the --positions joints held at their values;
+/// on bad input one line on stderr and exit code 2.
 
 #include <chrono>
 #include <cstdlib>
@@ -22,6 +22,11 @@ int fail(const std::string& line) {
 const char* kUsage =
     "usage: mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] "
     "[--rank-tolerance T] [--json]";
+
+/// --help: the usage line and what --positions does (errors print the usage line alone: one line).
+const char* kPositionsHelp =
+    "  --positions  hold these tree joints exactly at these values [rad or m]; the other joints follow by\n"
+    "               continuation from the written pose, in its assembly mode (exit 2 if a value is beyond reach)";
 
 }  // namespace
 
@@ -58,7 +63,7 @@ int main(int argc, char** argv) {
           }
         }
       } else if (arg == "-h" || arg == "--help") {
-        std::cout << kUsage << std::endl;
+        std::cout << kUsage << "\n" << kPositionsHelp << std::endl;
         return 0;
       } else if (!arg.empty() && arg[0] == '-') {
         return fail("mobility_report: unknown option '" + arg + "'; " + kUsage);

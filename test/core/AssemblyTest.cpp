@@ -19,7 +19,8 @@ TEST(Assembly, LoopWrittenFiveDegreesOpenCloses) {
   EXPECT_GT(a.initialResidual, 0.01);
   EXPECT_LT(a.finalResidual, 1e-9);
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
-    EXPECT_LT(computeJointResidual(mechanism, a.poses, static_cast<int>(j), lc), 1e-8) << mechanism.joints[j].name;
+    EXPECT_LT(computeJointResidual(mechanism, a.poses, static_cast<int>(j), lc), 1e-8)
+        << mechanism.joints[j].name;
   }
   // Least change: the ground does not move, and the crank stays near where it was written.
   EXPECT_TRUE(a.poses[mechanism.rootLink].isApprox(Eigen::Isometry3d::Identity(), 1e-12));
@@ -32,7 +33,7 @@ TEST(Assembly, ClosedMechanismIsLeftWhereItIs) {
   const LinkPoses start = computeTreePoses(mechanism, {});
   const Result<AssembledMechanism> assembled = assembleMechanism(mechanism, start, AnalysisMode::Spatial);
   ASSERT_TRUE(isOk(assembled));
-  EXPECT_EQ(valueOf(assembled).iterations, 0);
+  EXPECT_EQ(valueOf(assembled).iterations, 0);  // closed as written: nothing to do
   for (size_t l = 0; l < start.size(); ++l) {
     EXPECT_TRUE(valueOf(assembled).poses[l].isApprox(start[l], 1e-9)) << mechanism.links[l].name;
   }
@@ -59,4 +60,65 @@ TEST(Assembly, GivenPositionsAreTheStartingGuess) {
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     EXPECT_LT(computeJointResidual(mechanism, valueOf(assembled).poses, static_cast<int>(j), lc), 1e-8);
   }
+}
+
+namespace {
+
+std::string motionFixture(const std::string& name) {
+  return fixturePath("motion/" + name);
+}
+
+/// Assembles @p file from its written pose and checks that every connection holds.
+AssembledMechanism assembleAndCheck(const std::string& file) {
+  const Mechanism mechanism = loadOrFail(motionFixture(file));
+  const LinkPoses start = computeTreePoses(mechanism, {});
+  const double lc = computeCharacteristicLength(mechanism, start);
+  const Result<AssembledMechanism> assembled = assembleMechanism(mechanism, start, AnalysisMode::Auto);
+  if (!isOk(assembled)) {
+    ADD_FAILURE() << diagnosticOf(assembled).toString();
+    return AssembledMechanism{};
+  }
+  const AssembledMechanism& a = valueOf(assembled);
+  EXPECT_LE(a.finalResidual, 1e-12 * lc) << file;
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    EXPECT_LT(computeJointResidual(mechanism, a.poses, static_cast<int>(j), lc), 1e-9 * lc)
+        << file << ": " << mechanism.joints[j].name;
+  }
+  return a;
+}
+
+}  // namespace
+
+TEST(Assembly, PublishedModelsWrittenStraightClose) {
+  // Drake's FourBar and FourBar2 and generalized_rbda's six-bar are published with every joint at 0: the bars
+  // stand in one line, the loop is open by metres, and the start is a stationary point of the loop residual.
+  for (const char* file :
+       {"drake_four_bar_straight.urdf", "drake_four_bar2_straight.urdf", "six_bar_straight.urdf"}) {
+    const AssembledMechanism a = assembleAndCheck(file);
+    EXPECT_GT(a.initialResidual, 0.1) << file;  // really open as written
+    EXPECT_GT(a.iterations, 0) << file;
+  }
+}
+
+TEST(Assembly, WeldClosesWithItsFramesEqualNotTurnedOver) {
+  const Mechanism mechanism = loadOrFail(motionFixture("weld_leg.urdf"));
+  const AssembledMechanism a = assembleAndCheck("weld_leg.urdf");
+  ASSERT_EQ(a.poses.size(), mechanism.links.size());
+  const Joint& weld = mechanism.joints[*mechanism.findJoint("weld")];
+  const Eigen::Matrix3d r1 = (a.poses[weld.link1] * weld.frame1).linear();
+  const Eigen::Matrix3d r2 = (a.poses[weld.link2] * weld.frame2).linear();
+  // The angle of r1^T r2: 0 for a weld that holds, pi for one turned over.
+  EXPECT_NEAR(Eigen::AngleAxisd(r1.transpose() * r2).angle(), 0.0, 1e-9);
+  EXPECT_EQ(a.model.mode, AnalysisMode::Planar);
+}
+
+TEST(Assembly, UnclosableMessageIsOneLineWithTheResidualAndThePoseReached) {
+  const Mechanism mechanism = loadOrFail(fixturePath("bad_unclosable.urdf"));
+  const Result<AssembledMechanism> assembled =
+      assembleMechanism(mechanism, computeTreePoses(mechanism, {}), AnalysisMode::Auto);
+  ASSERT_FALSE(isOk(assembled));
+  const std::string line = diagnosticOf(assembled).toString();
+  EXPECT_EQ(line.find('\n'), std::string::npos) << line;
+  EXPECT_NE(line.find("residual"), std::string::npos) << line;
+  EXPECT_NE(line.find("pose reached: j1="), std::string::npos) << line;
 }

@@ -12,7 +12,8 @@ namespace {
 
 /// The JSON without the fields that carry the unit or the file name.
 std::string unitFree(std::string json) {
-  for (const char* key : {"robot", "file", "characteristic_length", "closure_residual", "rank_margin"}) {
+  for (const char* key : {"robot", "file", "characteristic_length", "closure_residual", "rank_margin",
+                          "assembly"}) {  // assembly: its residual is in metres
     json = std::regex_replace(json, std::regex(std::string("\\n  \"") + key + "\": [^\\n]*"), "");
   }
   return json;

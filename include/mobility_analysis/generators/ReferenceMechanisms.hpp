@@ -108,5 +108,14 @@ MechanismDescription makeStewart6Sps();
 
 /// Delta robot with ball-jointed parallelogram rods: spatial DOF 9 (passive 6, output 3), Grübler 9.
 MechanismDescription makeDeltaRobot();
+/**
+ * @brief Peaucellier–Lipkin straight-line linkage: ground pivots O and A with |OA| = crank |AP| = r, arms
+ *        OB = OD = L, rhombus PB = BQ = QD = DP = s (r = 1, L = 3, s = 1.5 [m]).
+ *
+ * O, P, Q stay collinear with |OP| |OQ| = L^2 - s^2 (inversion about O), and P runs on a circle through O, so
+ * Q runs on the line x = (L^2 - s^2) / (2 r) = 3.375. Expected: planar DOF 1, Grübler 1, redundant 0.
+ * @param[in] crankAngle Angle of AP from the ground line [rad], |angle| < 82.8 deg (|OP| >= L - s).
+ */
+MechanismDescription makePeaucellier(double crankAngle = 30.0 * M_PI / 180.0);
 
 }  // namespace mobility_analysis
