@@ -7,13 +7,16 @@
 
 #include <Eigen/Geometry>
 
+#include "mobility_analysis/Diagnostic.hpp"
+
 namespace mobility_analysis {
 
 /// Joint types of the closed-loop URDF dialect (DESIGN.md §2). `Planar` and `Floating` are URDF tree types.
 enum class JointType { Revolute, Continuous, Prismatic, Cylindrical, Spherical, Universal, Planar, Fixed, Floating };
 
 /// Where a connection between two links comes from; also the order of its equations (DESIGN.md §3).
-enum class ConnectionKind { TreeJoint, DistanceConstraint, Cable, LoopJoint };
+/// A Coupling (URDF `<mimic>`, URDF+ `<coupling>`) ties two 1-DOF tree joints: one equation, after the loops.
+enum class ConnectionKind { TreeJoint, DistanceConstraint, Cable, LoopJoint, Coupling };
 
 /// Passive cables constrain while taut; active cables are the driver and constrain nothing.
 enum class CableType { Passive, Active };
@@ -42,6 +45,12 @@ struct Joint {
   Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< Universal only: second unit axis, on link2.
   double length = 0.0;                               ///< Cable: declared length [m]; else unused.
   CableType cableType = CableType::Passive;          ///< Cable only.
+  /// Coupling only: value(follower) = multiplier * value(leader) + offset [rad or m], both 1-DOF tree joints
+  /// (indices into Mechanism::joints). link1 is the follower's child, link2 the leader's child.
+  int leader = -1;
+  int follower = -1;
+  double multiplier = 1.0;
+  double offset = 0.0;
 };
 
 /// Joint values by tree-joint name [rad] or [m].
@@ -51,7 +60,8 @@ using JointPositions = std::map<std::string, double>;
  * @brief An immutable closed-loop mechanism as read from the URDF.
  *
  * `joints` holds every connection in the order of its constraint equations: tree joints in document order,
- * then distance constraints, then cables, then loop joints (DESIGN.md §3).
+ * then distance constraints, then cables, then loop joints, then couplings (DESIGN.md §3). Whatever format it
+ * was read from (io/ReadMechanism.hpp), nothing downstream knows.
  */
 struct Mechanism {
   std::string name;             ///< URDF robot name.
@@ -59,6 +69,9 @@ struct Mechanism {
   std::vector<Link> links;      ///< Links in document order.
   std::vector<Joint> joints;    ///< Connections in equation order.
   int rootLink = 0;             ///< The ground.
+  /// What the reader met but did not understand or had to assume (one Diagnostic each); copied into the
+  /// report's `warnings` by analyzeMechanism. A strict read turns the first into an error.
+  std::vector<Diagnostic> warnings;
 
   /// @return Index of the link called @p linkName, if any.
   std::optional<int> findLink(const std::string& linkName) const;
@@ -70,7 +83,7 @@ struct Mechanism {
 
 /// @return The dialect's spelling of @p type ("revolute", …).
 const char* toString(JointType type);
-/// @return "joint", "distance_constraint", "cable" or "loop_joint".
+/// @return "joint", "distance_constraint", "cable", "loop_joint" or "coupling".
 const char* toString(ConnectionKind kind);
 
 }  // namespace mobility_analysis

@@ -50,6 +50,7 @@ const char* toString(ConnectionKind kind) {
     case ConnectionKind::DistanceConstraint: return "distance_constraint";
     case ConnectionKind::Cable: return "cable";
     case ConnectionKind::LoopJoint: return "loop_joint";
+    case ConnectionKind::Coupling: return "coupling";
   }
   return "unknown";
 }
