@@ -41,6 +41,8 @@ class EquationEvaluator {
         return direction(eq.a)[k] - eq.value;
       case EquationForm::Triple:
         return direction(eq.a).cross(direction(eq.b)).dot(direction(eq.c)) - eq.value;
+      case EquationForm::Coupling:
+        return evaluateCoupling(model_.couplings[eq.coupling], model_, q_);
       case EquationForm::Combination: {
         const Eigen::Vector3d d1 = direction(eq.d1);
         const Eigen::Vector3d d2 = second(eq);
@@ -92,6 +94,9 @@ class EquationEvaluator {
         addDirection(eq.c, a.cross(b), row, triplets);
         break;
       }
+      case EquationForm::Coupling:
+        appendCouplingGradient(model_.couplings[eq.coupling], model_, q_, row, triplets);
+        break;
       case EquationForm::Combination: {
         const Eigen::Vector3d& c = eq.coefficients;
         addElement(eq.target, ek, row, triplets);

@@ -69,6 +69,8 @@ const char* toString(EquationKind kind) {
       return "distance_constraint";
     case EquationKind::FixedCoordinate:
       return "fixed_coordinate";
+    case EquationKind::Coupling:
+      return "coupling";
   }
   return "unknown";
 }
@@ -97,7 +99,8 @@ bool isSpatialOnly(JointType type) {
 Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const LinkPoses& poses) {
   std::vector<Eigen::Vector3d> slides;
   for (const Joint& joint : mechanism.joints) {
-    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable)
+    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
+        joint.kind == ConnectionKind::Coupling)
       continue;
     const Eigen::Vector3d axis = worldAxes(joint, poses).first;
     if (joint.type == JointType::Revolute || joint.type == JointType::Continuous)
@@ -158,13 +161,14 @@ struct BodyBasis {
 std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const LinkPoses& poses) {
   for (const Joint& joint : mechanism.joints) {
     if (joint.kind != ConnectionKind::DistanceConstraint && joint.kind != ConnectionKind::Cable &&
-        isSpatialOnly(joint.type)) {
+        joint.kind != ConnectionKind::Coupling && isSpatialOnly(joint.type)) {
       return std::nullopt;
     }
   }
   const Eigen::Vector3d normal = candidateNormal(mechanism, poses);
   for (const Joint& joint : mechanism.joints) {
-    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable)
+    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
+        joint.kind == ConnectionKind::Coupling)
       continue;
     const auto axes = worldAxes(joint, poses);
     if (classifyPlanar(joint, axes.first, axes.second, normal) == PlanarForm::Invalid) {
@@ -206,6 +210,10 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     const Joint& joint = mechanism.joints[j];
     ConnectionElements& c = connections[j];
+    if (joint.kind == ConnectionKind::Coupling) {
+      model.jointFreedom[j] = model.lambda - 1;  // one equation, on the elements of the two joints it couples
+      continue;
+    }
     const auto axes = worldAxes(joint, poses);
     c.axisWorld = axes.first;
     if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable) {
@@ -393,6 +401,64 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
 
   auto addEquation = [&](ConstraintEquation eq) { model.equations.push_back(std::move(eq)); };
 
+  // A coupled tree joint's value from its elements (CouplingEquation.hpp): a prismatic joint's two points on
+  // its axis; a revolute joint's axis (planar: the normal) and the direction of each body most normal to it.
+  auto makeOperand = [&](int t) {
+    const Joint& tree = mechanism.joints[t];
+    const ConnectionElements& ct = connections[t];
+    JointValueOperand o;
+    o.prismatic = tree.type == JointType::Prismatic;
+    o.axis = planar && !o.prismatic ? -1 : ct.axis1;
+    if (o.prismatic) {
+      o.aHead = ct.point1;
+      o.bHead = ct.point2;
+      return o;
+    }
+    const Eigen::Vector3d u = o.axis < 0 ? Eigen::Vector3d::UnitZ() : coordinates(o.axis).normalized().eval();
+    auto mostNormal = [&](const BodyBasis& basis) {
+      Direction best = basis.d1;
+      double bestSine = -1.0;
+      for (const Direction& d : {basis.d1, basis.d2}) {
+        if (d.head < 0)
+          continue;
+        const Eigen::Vector3d v = directionValue(d);
+        const double sine = (v - v.dot(u) * u).norm() / std::max(v.norm(), 1e-300);
+        if (sine > bestSine) {
+          bestSine = sine;
+          best = d;
+        }
+      }
+      return best;
+    };
+    const Direction a = mostNormal(bases[tree.link1]);
+    const Direction b = mostNormal(bases[tree.link2]);
+    o.aHead = a.head;
+    o.aTail = a.tail;
+    o.bHead = b.head;
+    o.bTail = b.tail;
+    // theta_0: the angle between a and b with b turned back to the joint's zero (its two frames aligned).
+    const Eigen::Matrix3d aligned = poses[tree.link1].linear() * tree.frame1.linear() *
+                                    tree.frame2.linear().transpose() * poses[tree.link2].linear().transpose();
+    const Eigen::Vector3d bWorld = b.tail < 0 ? builder.world[b.head] : (builder.world[b.head] - builder.world[b.tail]).eval();
+    const Eigen::Vector3d bRest =
+        planar ? Eigen::Vector3d((aligned * bWorld).dot(model.planeE1), (aligned * bWorld).dot(model.planeE2), 0.0)
+               : (aligned * bWorld).eval();
+    const Eigen::Vector3d av = directionValue(a);
+    o.rest = std::atan2(u.dot(av.cross(bRest)), av.dot(bRest) - av.dot(u) * bRest.dot(u));
+    return o;
+  };
+  auto makeCouplingTerms = [&](const Joint& coupling) {
+    CouplingTerms terms;
+    terms.follower = makeOperand(coupling.follower);
+    terms.leader = makeOperand(coupling.leader);
+    // v_f [SI] = m v_l [SI] + c, with prismatic values in normalised lengths: scale by lc.
+    const double followerScale = terms.follower.prismatic ? lc : 1.0;
+    const double leaderScale = terms.leader.prismatic ? lc : 1.0;
+    terms.multiplier = coupling.multiplier * leaderScale / followerScale;
+    terms.offset = coupling.offset / followerScale;
+    return terms;
+  };
+
   // 4. Rigid-link equations (links in document order): basis dot products, then linear combinations.
   for (size_t b = 0; b < mechanism.links.size(); ++b) {
     const BodyBasis& basis = bases[b];
@@ -471,6 +537,13 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
       eq.form = form;
       return eq;
     };
+    if (joint.kind == ConnectionKind::Coupling) {
+      ConstraintEquation eq = base(EquationKind::Coupling, EquationForm::Coupling);
+      eq.coupling = static_cast<int>(model.couplings.size());
+      model.couplings.push_back(makeCouplingTerms(joint));
+      addEquation(eq);
+      continue;
+    }
     // Cross-product components: drop the one along the axis' largest component (it is degenerate there).
     auto crossComponents = [&](int axisElement) {
       std::vector<int> components;
@@ -785,6 +858,15 @@ std::string describeEquation(const CoordinateModel& model, int row) {
     case EquationKind::FixedCoordinate:
       return label(eq.a.head) + "_" + kAxisNames[eq.component] + " = " + number(eq.value) +
              (model.elements[eq.a.head].isPoint ? " Lc" : "");
+    case EquationKind::Coupling: {
+      const CouplingTerms& terms = model.couplings[eq.coupling];
+      auto value = [&](const JointValueOperand& o) {
+        return o.prismatic ? "s(" + label(o.aHead) + " -> " + label(o.bHead) + ")"
+                           : "angle(" + label(o.aHead) + ", " + label(o.bHead) + ")";
+      };
+      return value(terms.follower) + " = " + number(terms.multiplier) + " " + value(terms.leader) + " + " +
+             number(terms.offset) + (terms.follower.prismatic ? " Lc" : " rad");
+    }
     default:
       break;
   }
