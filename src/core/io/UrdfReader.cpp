@@ -300,7 +300,10 @@ class Reader {
       joint.type = *jointType;
       joint.link1 = parentLink;
       joint.link2 = childLink;
-      joint.frame1 = frame(e->FirstChildElement("origin"), "joint", name, "origin");
+      if (const tinyxml2::XMLElement* origin = e->FirstChildElement("origin")) {
+        joint.frame1 = io_detail::makeOriginFrame(vector(origin->Attribute("xyz"), "joint", name, "origin xyz"),
+                                                  vector(origin->Attribute("rpy"), "joint", name, "origin rpy"));
+      }
       if (joint.type != JointType::Fixed && joint.type != JointType::Floating)
         joint.axis = axis(e, "axis", "joint", name, Eigen::Vector3d::UnitX());
       if (const tinyxml2::XMLElement* mimic = e->FirstChildElement("mimic")) {

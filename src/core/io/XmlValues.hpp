@@ -54,6 +54,27 @@ inline Eigen::Isometry3d makeFrame(const Eigen::Vector3d& xyz, const Eigen::Vect
   return frame;
 }
 
+/**
+ * @brief A URDF `<joint><origin>` frame, its rotation through the quaternion of roll-pitch-yaw as urdfdom
+ *        computes it (then normalised), so tree-joint frames are bit for bit those urdfdom gave.
+ */
+inline Eigen::Isometry3d makeOriginFrame(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy) {
+  const double phi = rpy.x() / 2.0, the = rpy.y() / 2.0, psi = rpy.z() / 2.0;
+  double x = std::sin(phi) * std::cos(the) * std::cos(psi) - std::cos(phi) * std::sin(the) * std::sin(psi);
+  double y = std::cos(phi) * std::sin(the) * std::cos(psi) + std::sin(phi) * std::cos(the) * std::sin(psi);
+  double z = std::cos(phi) * std::cos(the) * std::sin(psi) - std::sin(phi) * std::sin(the) * std::cos(psi);
+  double w = std::cos(phi) * std::cos(the) * std::cos(psi) + std::sin(phi) * std::sin(the) * std::sin(psi);
+  const double norm = std::sqrt(x * x + y * y + z * z + w * w);
+  x /= norm;
+  y /= norm;
+  z /= norm;
+  w /= norm;
+  Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
+  frame.linear() = Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
+  frame.translation() = xyz;
+  return frame;
+}
+
 /// @return The base name of @p path (what diagnostics show).
 inline std::string baseName(const std::string& path) {
   const size_t slash = path.find_last_of('/');
