@@ -8,6 +8,7 @@
 namespace mobility_analysis {
 
 struct CoordinateModel;
+struct ModelBuilder;
 
 /**
  * @brief One 1-DOF tree joint's value as a function of the natural coordinates.
@@ -65,5 +66,16 @@ void appendCouplingGradient(const CouplingTerms& terms, const CoordinateModel& m
 void computeCouplingHessian(const CouplingTerms& terms, const CoordinateModel& model,
                             const Eigen::Ref<const Eigen::VectorXd>& q, std::vector<int>& columns,
                             Eigen::MatrixXd& hessian);
+
+/**
+ * @brief Phase 5 of buildCoordinateModel for a coupling (coordinates/JointEquations.cpp calls it): builds the
+ *        operands of both joints from their elements and the bodies' bases, and appends the one equation
+ *        (EquationForm::Coupling, coordinates/EquationForms.hpp CouplingForm).
+ *
+ * A prismatic joint's value is read from its two points along its axis; a revolute one's from its axis (planar:
+ * the plane normal) and, on each body, the basis direction most normal to it, with theta_0 measured with the
+ * child turned back to the joint's zero.
+ */
+void addCouplingEquation(ModelBuilder& builder, int joint);
 
 }  // namespace mobility_analysis

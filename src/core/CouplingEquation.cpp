@@ -5,6 +5,8 @@
 #include <map>
 
 #include "mobility_analysis/NaturalCoordinates.hpp"
+#include "mobility_analysis/coordinates/EquationForms.hpp"
+#include "mobility_analysis/coordinates/ModelBuilder.hpp"
 
 namespace mobility_analysis {
 
@@ -132,6 +134,93 @@ void computeCouplingHessian(const CouplingTerms& terms, const CoordinateModel& m
     hessian.col(j) = (plus - minus) / (2.0 * kStep);
   }
   hessian = (0.5 * (hessian + hessian.transpose())).eval();
+}
+
+void addCouplingEquation(ModelBuilder& builder, int j) {
+  const Mechanism& mechanism = builder.mechanism;
+  CoordinateModel& model = builder.model;
+  const bool planar = builder.planar();
+  auto makeOperand = [&](int t) {
+    const Joint& tree = mechanism.joints[t];
+    const ConnectionElements& ct = builder.connections[t];
+    JointValueOperand o;
+    o.prismatic = tree.type == JointType::Prismatic;
+    o.axis = planar && !o.prismatic ? -1 : ct.axis1;
+    if (o.prismatic) {
+      o.aHead = ct.point1;
+      o.bHead = ct.point2;
+      return o;
+    }
+    const Eigen::Vector3d u =
+        o.axis < 0 ? Eigen::Vector3d::UnitZ().eval() : builder.coordinates(o.axis).normalized().eval();
+    auto mostNormal = [&](const BodyBasis& basis) {
+      Direction best = basis.d1;
+      double bestSine = -1.0;
+      for (const Direction& d : {basis.d1, basis.d2}) {
+        if (d.head < 0)
+          continue;
+        const Eigen::Vector3d v = builder.directionValue(d);
+        const double sine = (v - v.dot(u) * u).norm() / std::max(v.norm(), 1e-300);
+        if (sine > bestSine) {
+          bestSine = sine;
+          best = d;
+        }
+      }
+      return best;
+    };
+    const Direction a = mostNormal(builder.bases[tree.link1]);
+    const Direction b = mostNormal(builder.bases[tree.link2]);
+    o.aHead = a.head;
+    o.aTail = a.tail;
+    o.bHead = b.head;
+    o.bTail = b.tail;
+    // theta_0: the angle between a and b with b turned back to the joint's zero (its two frames aligned).
+    const Eigen::Matrix3d aligned = builder.poses[tree.link1].linear() * tree.frame1.linear() *
+                                    tree.frame2.linear().transpose() *
+                                    builder.poses[tree.link2].linear().transpose();
+    const Eigen::Vector3d bRest = builder.project(aligned * builder.worldOf(b));
+    const Eigen::Vector3d av = builder.directionValue(a);
+    o.rest = std::atan2(u.dot(av.cross(bRest)), av.dot(bRest) - av.dot(u) * bRest.dot(u));
+    return o;
+  };
+  const Joint& coupling = mechanism.joints[j];
+  CouplingTerms terms;
+  terms.follower = makeOperand(coupling.follower);
+  terms.leader = makeOperand(coupling.leader);
+  // v_f [SI] = m v_l [SI] + c, with prismatic values in normalised lengths: scale by Lc.
+  const double lc = model.characteristicLength;
+  const double followerScale = terms.follower.prismatic ? lc : 1.0;
+  const double leaderScale = terms.leader.prismatic ? lc : 1.0;
+  terms.multiplier = coupling.multiplier * leaderScale / followerScale;
+  terms.offset = coupling.offset / followerScale;
+  ConstraintEquation eq;
+  eq.source = EquationSource::Joint;
+  eq.element = j;
+  eq.kind = EquationKind::Coupling;
+  eq.form = EquationForm::Coupling;
+  eq.coupling = static_cast<int>(model.couplings.size());
+  model.couplings.push_back(terms);
+  model.equations.push_back(eq);
+}
+
+double CouplingForm::value(const ElementView& v, const ConstraintEquation& eq) {
+  return evaluateCoupling(v.model().couplings[eq.coupling], v.model(), v.q());
+}
+
+void CouplingForm::gradient(const ElementView& v, const ConstraintEquation& eq, int row, GradientSink& sink) {
+  appendCouplingGradient(v.model().couplings[eq.coupling], v.model(), v.q(), row, sink);
+}
+
+void CouplingForm::hessian(const ElementView& v, const ConstraintEquation& eq, double weight, HessianSink& sink) {
+  std::vector<int> columns;
+  Eigen::MatrixXd hessian;
+  computeCouplingHessian(v.model().couplings[eq.coupling], v.model(), v.q(), columns, hessian);
+  for (size_t a = 0; a < columns.size(); ++a) {
+    for (size_t b = 0; b < columns.size(); ++b) {
+      if (hessian(a, b) != 0.0)
+        sink.emplace_back(columns[a], columns[b], weight * hessian(a, b));
+    }
+  }
 }
 
 }  // namespace mobility_analysis
