@@ -517,3 +517,47 @@ TEST(DeepTrees, AChainOfTwoHundredThousandLinksLoads) {
   ASSERT_FALSE(isOk(c));
   EXPECT_NE(diagnosticOf(c).toString().find("cycle"), std::string::npos);
 }
+
+TEST(Readers, MjcfWeldHoldsTwoBodiesTogether) {
+  // Two cranks on parallel hinges, welded to each other: nothing moves. In the plane 3*2 - 2*2 - 3 = -1, so one
+  // equation is redundant; in space 6*2 - 5*2 - 6 = -4, four.
+  const std::string path = ::testing::TempDir() + "weld.xml";
+  std::ofstream(path) << R"(<mujoco model="weld"><worldbody>
+  <body name="a"><joint name="ja" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.01"/></body>
+  <body name="b" pos="1 0 0"><joint name="jb" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 -0.5 0 0" size="0.01"/></body>
+  </worldbody><equality><weld name="glue" body1="a" body2="b"/></equality></mujoco>)";
+  const Mechanism m = readOrFail(path);
+  EXPECT_EQ(m.joints[*m.findJoint("glue")].type, JointType::Fixed);
+  const MobilityReport planar = reportOf(m, AnalysisMode::Auto);
+  EXPECT_EQ(planar.mode, "planar");
+  EXPECT_EQ(planar.dof, 0);
+  EXPECT_EQ(planar.grublerKutzbachDof, -1);
+  EXPECT_EQ(planar.numRedundant, 1);
+  const MobilityReport spatial = reportOf(m, AnalysisMode::Spatial);
+  EXPECT_EQ(spatial.dof, 0);
+  EXPECT_EQ(spatial.grublerKutzbachDof, -4);
+  EXPECT_EQ(spatial.numRedundant, 4);
+}
+
+TEST(Readers, ClosureFileNamesTypesAndFramesOfJoints) {
+  // A frame may be a tree joint (its child link's frame); joint_type SPHERICAL makes a 6d pair a ball.
+  const std::string yaml = ::testing::TempDir() + "named.yaml";
+  std::ofstream(yaml) << "closed_loop: [['to_closure_A', 'free_B']]\ntype: ['6d']\njoint_name: ['C']\n"
+                         "joint_type: ['SPHERICAL']\n";
+  ReadOptions options;
+  options.closuresFile = yaml;
+  const Mechanism m = readOrFail(formatPath("five_bar_gepetto.urdf"), options);
+  EXPECT_TRUE(m.warnings.empty());
+  const Joint& c = m.joints[*m.findJoint("C")];
+  EXPECT_EQ(c.kind, ConnectionKind::LoopJoint);
+  EXPECT_EQ(c.type, JointType::Spherical);
+  EXPECT_EQ(m.links[c.link1].name, "closure_A");
+  EXPECT_EQ(m.links[c.link2].name, "closure_B");
+  // Same as the 3d closure file: DOF 3.
+  EXPECT_EQ(reportOf(m, AnalysisMode::Auto).dof, 3);
+  // Sizes that differ are named.
+  std::ofstream(yaml) << "closed_loop: [['closure_A', 'closure_B'], ['closure_A', 'crank_left']]\ntype: ['6d']\n";
+  const Result<Mechanism> bad = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
+  ASSERT_FALSE(isOk(bad));
+  EXPECT_NE(diagnosticOf(bad).what.find("1 types for 2 closed_loop pairs"), std::string::npos);
+}
