@@ -13,10 +13,10 @@ struct ModelBuilder;
 /**
  * @brief One 1-DOF tree joint's value as a function of the natural coordinates.
  *
- * Revolute: \f$ \theta = \operatorname{atan2}(u\cdot(a\times b),\ a\cdot b - (a\cdot u)(b\cdot u)) - \theta_0 \f$
- * with a a direction of the parent, b one of the child and u the axis on the parent (planar: the plane normal),
- * wrapped to (-pi, pi]. Prismatic: \f$ s = (P_{child} - P_{parent})\cdot u - s_0 \f$ [normalised length].
- * Element indices refer to CoordinateModel::elements.
+ * Revolute: \f$ \theta = \operatorname{atan2}(u\cdot(a\times b),\ a\cdot b - (a\cdot u)(b\cdot u)) - \theta_0
+ * \f$ with a a direction of the parent, b one of the child and u the axis on the parent (planar: the plane
+ * normal), wrapped to (-pi, pi]. Prismatic: \f$ s = (P_{child} - P_{parent})\cdot u - s_0 \f$ [normalised
+ * length]. Element indices refer to CoordinateModel::elements.
  */
 struct JointValueOperand {
   bool prismatic = false;
@@ -72,9 +72,9 @@ void computeCouplingHessian(const CouplingTerms& terms, const CoordinateModel& m
  *        operands of both joints from their elements and the bodies' bases, and appends the one equation
  *        (EquationForm::Coupling, coordinates/EquationForms.hpp CouplingForm).
  *
- * A prismatic joint's value is read from its two points along its axis; a revolute one's from its axis (planar:
- * the plane normal) and, on each body, the basis direction most normal to it, with theta_0 measured with the
- * child turned back to the joint's zero.
+ * A prismatic joint's value is read from its two points along its axis; a revolute one's from its axis
+ * (planar: the plane normal) and, on each body, the basis direction most normal to it, with theta_0 measured
+ * with the child turned back to the joint's zero.
  */
 void addCouplingEquation(ModelBuilder& builder, int joint);
 

@@ -14,7 +14,8 @@ namespace {
 
 Eigen::Vector3d element(const CoordinateModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, int e) {
   const int offset = model.elements[e].offset;
-  return model.dim == 3 ? Eigen::Vector3d(q.segment<3>(offset)) : Eigen::Vector3d(q(offset), q(offset + 1), 0.0);
+  return model.dim == 3 ? Eigen::Vector3d(q.segment<3>(offset))
+                        : Eigen::Vector3d(q(offset), q(offset + 1), 0.0);
 }
 
 Eigen::Vector3d direction(const CoordinateModel& model, const Eigen::Ref<const Eigen::VectorXd>& q, int head,
@@ -86,8 +87,8 @@ double evaluateJointValue(const JointValueOperand& o, const CoordinateModel& mod
 
 double evaluateCoupling(const CouplingTerms& terms, const CoordinateModel& model,
                         const Eigen::Ref<const Eigen::VectorXd>& q) {
-  return evaluateJointValue(terms.follower, model, q) - terms.multiplier * evaluateJointValue(terms.leader, model, q) -
-         terms.offset;
+  return evaluateJointValue(terms.follower, model, q) -
+         terms.multiplier * evaluateJointValue(terms.leader, model, q) - terms.offset;
 }
 
 void appendCouplingGradient(const CouplingTerms& terms, const CoordinateModel& model,
@@ -211,7 +212,8 @@ void CouplingForm::gradient(const ElementView& v, const ConstraintEquation& eq, 
   appendCouplingGradient(v.model().couplings[eq.coupling], v.model(), v.q(), row, sink);
 }
 
-void CouplingForm::hessian(const ElementView& v, const ConstraintEquation& eq, double weight, HessianSink& sink) {
+void CouplingForm::hessian(const ElementView& v, const ConstraintEquation& eq, double weight,
+                           HessianSink& sink) {
   std::vector<int> columns;
   Eigen::MatrixXd hessian;
   computeCouplingHessian(v.model().couplings[eq.coupling], v.model(), v.q(), columns, hessian);

@@ -41,7 +41,8 @@ std::string Diagnostic::toString() const {
   return line + escapeForLine(what);
 }
 
-Diagnostic makeDiagnostic(std::string file, std::string elementKind, std::string elementName, std::string what) {
+Diagnostic makeDiagnostic(std::string file, std::string elementKind, std::string elementName,
+                          std::string what) {
   return Diagnostic{std::move(file), std::move(elementKind), std::move(elementName), std::move(what)};
 }
 

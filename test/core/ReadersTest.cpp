@@ -1,6 +1,6 @@
 /// The readers of io/: every dialect against its closed form and its hand-converted <loop_joint> twin,
-/// couplings as constraints, warnings that never let a loop go silently, strictness, one-line diagnostics with
-/// hostile names, extreme numbers, deep trees.
+/// couplings as constraints, warnings that never let a loop go silently, strictness, one-line diagnostics
+/// with hostile names, extreme numbers, deep trees.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -16,7 +16,9 @@ using namespace mobility_analysis;
 
 namespace {
 
-std::string formatPath(const std::string& name) { return fixturePath("formats/" + name); }
+std::string formatPath(const std::string& name) {
+  return fixturePath("formats/" + name);
+}
 
 std::string readText(const std::string& path) {
   std::ifstream in(path);
@@ -61,20 +63,23 @@ void expectOneLine(const std::string& line) {
 
 std::vector<std::string> warningTexts(const Mechanism& mechanism) {
   std::vector<std::string> texts;
-  for (const Diagnostic& d : mechanism.warnings) texts.push_back(d.toString());
+  for (const Diagnostic& d : mechanism.warnings)
+    texts.push_back(d.toString());
   return texts;
 }
 
 bool anyContains(const std::vector<std::string>& texts, const std::string& a, const std::string& b = "") {
   for (const std::string& t : texts) {
-    if (t.find(a) != std::string::npos && t.find(b) != std::string::npos) return true;
+    if (t.find(a) != std::string::npos && t.find(b) != std::string::npos)
+      return true;
   }
   return false;
 }
 
 }  // namespace
 
-// --- every dialect: closed form, and the same numbers as the hand-converted <loop_joint> twin ----------------
+// --- every dialect: closed form, and the same numbers as the hand-converted <loop_joint> twin
+// ----------------
 
 struct DialectCase {
   const char* file;
@@ -90,7 +95,8 @@ class EveryDialect : public ::testing::TestWithParam<DialectCase> {};
 TEST_P(EveryDialect, GivesItsClosedFormDofAndTheNumbersOfItsLoopJointTwin) {
   const DialectCase& c = GetParam();
   ReadOptions options;
-  if (*c.closures != '\0') options.closuresFile = formatPath(c.closures);
+  if (*c.closures != '\0')
+    options.closuresFile = formatPath(c.closures);
   const Mechanism mechanism = readOrFail(formatPath(c.file), options);
   EXPECT_TRUE(mechanism.warnings.empty()) << mechanism.warnings.front().toString();
   const MobilityReport report = reportOf(mechanism, c.mode);
@@ -113,13 +119,16 @@ TEST_P(EveryDialect, GivesItsClosedFormDofAndTheNumbersOfItsLoopJointTwin) {
 INSTANTIATE_TEST_SUITE_P(
     Formats, EveryDialect,
     ::testing::Values(
-        DialectCase{"four_bar_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, "four_bar_loop_joint.urdf"},
+        DialectCase{"four_bar_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0,
+                    "four_bar_loop_joint.urdf"},
         DialectCase{"four_bar_urdfplus.urdf", "", AnalysisMode::Spatial, "spatial", 1, -2, 3,
                     "four_bar_loop_joint.urdf"},
-        DialectCase{"six_bar_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, "six_bar_loop_joint.urdf"},
+        DialectCase{"six_bar_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0,
+                    "six_bar_loop_joint.urdf"},
         DialectCase{"six_bar_urdfplus.urdf", "", AnalysisMode::Spatial, "spatial", 1, -5, 6,
                     "six_bar_loop_joint.urdf"},
-        DialectCase{"four_bar_drake.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, "four_bar_loop_joint.urdf"},
+        DialectCase{"four_bar_drake.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0,
+                    "four_bar_loop_joint.urdf"},
         DialectCase{"four_bar_drake.urdf", "", AnalysisMode::Spatial, "spatial", 1, -2, 3,
                     "four_bar_loop_joint.urdf"},
         DialectCase{"five_bar_gepetto.urdf", "five_bar_6d.yaml", AnalysisMode::Auto, "planar", 2, 2, 0,
@@ -127,7 +136,8 @@ INSTANTIATE_TEST_SUITE_P(
         // 3d: a ball at C, so in space: the five-bar's 2 plus closure_B spinning on its pin; 6*6-25-6-3 = 2.
         DialectCase{"five_bar_gepetto.urdf", "five_bar_3d.yaml", AnalysisMode::Auto, "spatial", 3, 2, 1, ""},
         // MJCF connect is a ball: 6*3 - 5*3 - 3 = 0, the planar motion makes one equation redundant.
-        DialectCase{"four_bar_mjcf.xml", "", AnalysisMode::Auto, "spatial", 1, 0, 1, "four_bar_ball_loop_joint.urdf"},
+        DialectCase{"four_bar_mjcf.xml", "", AnalysisMode::Auto, "spatial", 1, 0, 1,
+                    "four_bar_ball_loop_joint.urdf"},
         // Cassie-like leg: hip-knee four-bar through the Achilles rod (1) + the rod's spin (1); 36 - 34 = 2.
         DialectCase{"leg_mjcf.xml", "", AnalysisMode::Auto, "spatial", 2, 2, 0, ""},
         // Couplings: tree minus one.
@@ -141,8 +151,8 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(Readers, WithoutItsLoopsEachModelIsTheOpenTreeItWouldBeAnalysedAsToday) {
-  // The issue's complaint: loops dropped silently give the tree's DOF. Our readers give these only when the loop
-  // really is absent (the loop text removed), and then nothing warns.
+  // The issue's complaint: loops dropped silently give the tree's DOF. Our readers give these only when the
+  // loop really is absent (the loop text removed), and then nothing warns.
   std::string plus = readText(formatPath("four_bar_urdfplus.urdf"));
   plus = std::regex_replace(plus, std::regex("<loop [\\s\\S]*</loop>"), "");
   const Result<Mechanism> tree = readMechanismFromString(plus, "tree.urdf");
@@ -190,21 +200,25 @@ TEST(Readers, MjcfBodiesJointsAndEqualitiesMeanWhatMujocoMeans) {
   EXPECT_EQ(m.joints.back().kind, ConnectionKind::Coupling);  // couplings after every loop joint
 }
 
-// --- couplings are constraints -------------------------------------------------------------------------------
+// --- couplings are constraints
+// -------------------------------------------------------------------------------
 
 TEST(Couplings, HoldTheFollowerAtMultiplierTimesTheLeaderPlusOffset) {
   // b = -a + 0.1 (gripper_revolute_mimic.urdf): written with both at 0, the assembly closes the coupling.
-  const MobilityReport report = reportOf(readOrFail(formatPath("gripper_revolute_mimic.urdf")), AnalysisMode::Auto);
+  const MobilityReport report =
+      reportOf(readOrFail(formatPath("gripper_revolute_mimic.urdf")), AnalysisMode::Auto);
   ASSERT_EQ(report.positions.size(), 2u);
   EXPECT_NEAR(report.positions[1].value, -report.positions[0].value + 0.1, 1e-9);
   // A gear with a prismatic follower: 0.02 m per rad, offset 0.01 m, in millimetres and metres alike.
   for (const double unit : {1.0, 0.001}) {
     std::ostringstream urdf;
     urdf << "<robot name='rack'><link name='g'/><link name='pinion'/><link name='rack'/>"
-         << "<joint name='turn' type='continuous'><parent link='g'/><child link='pinion'/><axis xyz='0 0 1'/></joint>"
+         << "<joint name='turn' type='continuous'><parent link='g'/><child link='pinion'/><axis xyz='0 0 "
+            "1'/></joint>"
          << "<joint name='slide' type='prismatic'><parent link='g'/><child link='rack'/>"
          << "<origin xyz='0 " << 0.05 / unit << " 0'/><axis xyz='1 0 0'/>"
-         << "<mimic joint='turn' multiplier='" << 0.02 / unit << "' offset='" << 0.01 / unit << "'/></joint></robot>";
+         << "<mimic joint='turn' multiplier='" << 0.02 / unit << "' offset='" << 0.01 / unit
+         << "'/></joint></robot>";
     const Result<Mechanism> m = readMechanismFromString(urdf.str(), "rack.urdf");
     ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
     const MobilityReport r = reportOf(valueOf(m), AnalysisMode::Auto);
@@ -216,8 +230,8 @@ TEST(Couplings, HoldTheFollowerAtMultiplierTimesTheLeaderPlusOffset) {
 }
 
 TEST(Couplings, TakePartInTheOrderedRedundancyAfterTheLoopJoints) {
-  // The same gear ratio said twice (a mimic and a URDF+ coupling): the second equation, the <coupling>, is the
-  // redundant one, reported with its own source kind.
+  // The same gear ratio said twice (a mimic and a URDF+ coupling): the second equation, the <coupling>, is
+  // the redundant one, reported with its own source kind.
   const char* text = R"(<robot name="twice">
   <link name="ground"/><link name="a"/><link name="b"/>
   <joint name="ja" type="continuous"><parent link="ground"/><child link="a"/><axis xyz="0 0 1"/></joint>
@@ -247,10 +261,12 @@ TEST(Couplings, GradientAndHessianMatchCentralDifferences) {
       const Mechanism m = readOrFail(formatPath(file));
       JointPositions positions;
       for (const Joint& j : m.joints) {
-        if (j.kind == ConnectionKind::TreeJoint) positions[j.name] = 0.3 + 0.1 * positions.size();
+        if (j.kind == ConnectionKind::TreeJoint)
+          positions[j.name] = 0.3 + 0.1 * positions.size();
       }
       const LinkPoses poses = computeTreePoses(m, positions);
-      const Result<CoordinateModel> built = buildCoordinateModel(m, poses, mode, computeCharacteristicLength(m, poses));
+      const Result<CoordinateModel> built =
+          buildCoordinateModel(m, poses, mode, computeCharacteristicLength(m, poses));
       ASSERT_TRUE(isOk(built)) << diagnosticOf(built).toString();
       const CoordinateModel& model = valueOf(built);
       ASSERT_EQ(model.couplings.size(), 1u) << file;
@@ -266,7 +282,8 @@ TEST(Couplings, GradientAndHessianMatchCentralDifferences) {
         qm(c) -= h;
         computeConstraintResidual(model, qp, phiPlus);
         computeConstraintResidual(model, qm, phiMinus);
-        EXPECT_NEAR(J.coeff(row, c), (phiPlus(row) - phiMinus(row)) / (2 * h), 1e-7) << file << " column " << c;
+        EXPECT_NEAR(J.coeff(row, c), (phiPlus(row) - phiMinus(row)) / (2 * h), 1e-7)
+            << file << " column " << c;
       }
       // The Hessian against differences of the residual itself (second differences), on its own columns.
       std::vector<int> columns;
@@ -290,7 +307,8 @@ TEST(Couplings, GradientAndHessianMatchCentralDifferences) {
   }
 }
 
-// --- never silent ---------------------------------------------------------------------------------------------
+// --- never silent
+// ---------------------------------------------------------------------------------------------
 
 TEST(Warnings, EveryClassFiresAndNamesItsElement) {
   const char* text = R"(<robot name="w">
@@ -361,14 +379,16 @@ TEST(Warnings, ReachTheReport) {
   const MobilityReport report = reportOf(valueOf(m), AnalysisMode::Auto);
   ASSERT_EQ(report.warnings.size(), 1u);
   EXPECT_NE(report.warnings[0].find("did you mean <loop_joint>"), std::string::npos);
-  EXPECT_NE(toJson(report).find("\"warnings\": [\"r.urdf: loopjoint 'x': unknown element"), std::string::npos);
+  EXPECT_NE(toJson(report).find("\"warnings\": [\"r.urdf: loopjoint 'x': unknown element"),
+            std::string::npos);
 }
 
 TEST(Warnings, StrictMakesTheFirstAnError) {
   ReadOptions strict;
   strict.strict = true;
-  const char* text = "<robot name='r'><link name='g'/><link name='a'/><joint name='j' type='revolute'>"
-                     "<parent link='g'/><child link='a'/><axis xyz='0 0 1'/></joint><loopjoint name='x'/></robot>";
+  const char* text =
+      "<robot name='r'><link name='g'/><link name='a'/><joint name='j' type='revolute'>"
+      "<parent link='g'/><child link='a'/><axis xyz='0 0 1'/></joint><loopjoint name='x'/></robot>";
   const Result<Mechanism> m = readMechanismFromString(text, "r.urdf", strict);
   ASSERT_FALSE(isOk(m));
   EXPECT_EQ(diagnosticOf(m).elementKind, "loopjoint");
@@ -377,7 +397,8 @@ TEST(Warnings, StrictMakesTheFirstAnError) {
   EXPECT_TRUE(isOk(readMechanism(formatPath("four_bar_urdfplus.urdf"), strict)));
 }
 
-// --- bad input: one line, every error class, hostile names ------------------------------------------------------
+// --- bad input: one line, every error class, hostile names
+// ------------------------------------------------------
 
 TEST(Diagnostics, EscapeNewlinesAndControlCharacters) {
   EXPECT_EQ(escapeForLine("gro\nund\t\r\x01\x7f ok"), "gro\\nund\\t\\r\\x01\\x7f ok");
@@ -393,26 +414,73 @@ struct HostileCase {
 
 TEST(Diagnostics, EveryErrorClassWithAHostileNameGivesOneLine) {
   const std::string h = "evil&#10;name&#9;\x01";  // newline, tab and a raw control character in a name
-  const std::string tree = "<link name='g'/><link name='a'/><link name='b'/>"
-                           "<joint name='ja' type='revolute'><parent link='g'/><child link='a'/><axis xyz='0 0 1'/></joint>";
+  const std::string tree =
+      "<link name='g'/><link name='a'/><link name='b'/>"
+      "<joint name='ja' type='revolute'><parent link='g'/><child link='a'/><axis xyz='0 0 1'/></joint>";
   const std::string full = tree + "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint>";
   const std::vector<HostileCase> cases = {
       {"xml", "<?xml version='1.0'\n?><robot><", "xml"},
       {"not robot", "<evil\x01/>", "xml"},
-      {"unknown link", "<robot name='r'>" + full + "<loop_joint name='" + h + "' type='fixed'><link1 link='a'/><link2 link='" + h + "'/></loop_joint></robot>", "loop_joint"},
-      {"two parents", "<robot name='r'>" + tree + "<joint name='" + h + "' type='fixed'><parent link='g'/><child link='a'/></joint></robot>", "joint"},
-      {"bad number", "<robot name='r'>" + tree + "<joint name='" + h + "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 " + h + " 0'/></joint></robot>", "joint"},
-      {"non-finite", "<robot name='r'>" + tree + "<joint name='" + h + "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 nan 0'/></joint></robot>", "joint"},
-      {"out of range", "<robot name='r'>" + tree + "<joint name='" + h + "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 0 1e308'/></joint></robot>", "joint"},
-      {"zero axis", "<robot name='r'>" + tree + "<joint name='" + h + "' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 0'/></joint></robot>", "joint"},
-      {"duplicate", "<robot name='r'>" + tree + "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint><distance_constraint name='jb'><link1 link='a'/><link2 link='b'/></distance_constraint></robot>", "distance_constraint"},
+      {"unknown link",
+       "<robot name='r'>" + full + "<loop_joint name='" + h +
+           "' type='fixed'><link1 link='a'/><link2 link='" + h + "'/></loop_joint></robot>",
+       "loop_joint"},
+      {"two parents",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='g'/><child link='a'/></joint></robot>",
+       "joint"},
+      {"bad number",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 " + h + " 0'/></joint></robot>",
+       "joint"},
+      {"non-finite",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 nan 0'/></joint></robot>",
+       "joint"},
+      {"out of range",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 0 1e308'/></joint></robot>",
+       "joint"},
+      {"zero axis",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 0'/></joint></robot>",
+       "joint"},
+      {"duplicate",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint><distance_constraint "
+           "name='jb'><link1 link='a'/><link2 link='b'/></distance_constraint></robot>",
+       "distance_constraint"},
       {"disconnected", "<robot name='r'><link name='g'/><link name='" + h + "'/></robot>", "link"},
-      {"loop type", "<robot name='r'>" + full + "<loop name='l' type='" + h + "'><predecessor link='a'/><successor link='g'/></loop></robot>", "loop"},
-      {"tree type", "<robot name='r'>" + tree + "<joint name='jb' type='" + h + "'><parent link='a'/><child link='b'/></joint></robot>", "joint"},
-      {"cable", "<robot name='r'>" + tree + "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint><cable name='" + h + "' length='-1'><link1 link='a'/><link2 link='b'/></cable></robot>", "cable"},
-      {"mimic leader", "<robot name='r'>" + tree + "<joint name='jb' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 1'/><mimic joint='" + h + "'/></joint></robot>", "joint"},
-      {"coupling ratio", "<robot name='r'>" + tree + "<joint name='jb' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 1'/></joint><coupling name='" + h + "'><predecessor joint='ja'/><successor joint='jb'/><ratio value='" + h + "'/></coupling></robot>", "coupling"},
-      {"self loop", "<robot name='r'>" + full + "<loop_joint name='" + h + "' type='fixed'><link1 link='a'/><link2 link='a'/></loop_joint></robot>", "loop_joint"},
+      {"loop type",
+       "<robot name='r'>" + full + "<loop name='l' type='" + h +
+           "'><predecessor link='a'/><successor link='g'/></loop></robot>",
+       "loop"},
+      {"tree type",
+       "<robot name='r'>" + tree + "<joint name='jb' type='" + h +
+           "'><parent link='a'/><child link='b'/></joint></robot>",
+       "joint"},
+      {"cable",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint><cable name='" + h +
+           "' length='-1'><link1 link='a'/><link2 link='b'/></cable></robot>",
+       "cable"},
+      {"mimic leader",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 1'/><mimic "
+           "joint='" +
+           h + "'/></joint></robot>",
+       "joint"},
+      {"coupling ratio",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 "
+           "1'/></joint><coupling name='" +
+           h + "'><predecessor joint='ja'/><successor joint='jb'/><ratio value='" + h +
+           "'/></coupling></robot>",
+       "coupling"},
+      {"self loop",
+       "<robot name='r'>" + full + "<loop_joint name='" + h +
+           "' type='fixed'><link1 link='a'/><link2 link='a'/></loop_joint></robot>",
+       "loop_joint"},
   };
   for (const HostileCase& c : cases) {
     const Result<Mechanism> m = readMechanismFromString(c.text, "evil\nfile.urdf");
@@ -421,8 +489,9 @@ TEST(Diagnostics, EveryErrorClassWithAHostileNameGivesOneLine) {
     expectOneLine(diagnosticOf(m).toString());
   }
   // The closure file: an unknown frame and a malformed YAML (yaml-cpp's message), each one line.
-  for (const std::string& yaml : {std::string("closed_loop: [['nowhere\\nland', 'closure_B']]\ntype: ['6d']\n"),
-                                  std::string("closed_loop: [[\n  'a\x01'\ntype: {")}) {
+  for (const std::string& yaml :
+       {std::string("closed_loop: [['nowhere\\nland', 'closure_B']]\ntype: ['6d']\n"),
+        std::string("closed_loop: [[\n  'a\x01'\ntype: {")}) {
     ReadOptions options;
     options.closuresFile = writeTemp("hostile.yaml", yaml);
     const Result<Mechanism> m = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
@@ -443,7 +512,8 @@ TEST(Diagnostics, EveryErrorClassWithAHostileNameGivesOneLine) {
   expectOneLine(diagnosticOf(p).toString());
 }
 
-// --- numbers: representable where they enter, never inf/nan in a written report ---------------------------------
+// --- numbers: representable where they enter, never inf/nan in a written report
+// ---------------------------------
 
 TEST(Numbers, OutOfRangeCoordinatesAndPositionsAreRefusedWhereTheyEnter) {
   std::string text = readText(formatPath("four_bar_loop_joint.urdf"));
@@ -453,7 +523,8 @@ TEST(Numbers, OutOfRangeCoordinatesAndPositionsAreRefusedWhereTheyEnter) {
   EXPECT_EQ(diagnosticOf(m).elementName, "j3");
   EXPECT_NE(diagnosticOf(m).what.find("range"), std::string::npos);
   // 1e12 is the documented edge: accepted; beyond it refused.
-  EXPECT_TRUE(isOk(readMechanismFromString(std::regex_replace(text, std::regex("xyz=\"0.4 0 0\""), "xyz=\"0.4 0 1e12\""), "x.urdf")));
+  EXPECT_TRUE(isOk(readMechanismFromString(
+      std::regex_replace(text, std::regex("xyz=\"0.4 0 0\""), "xyz=\"0.4 0 1e12\""), "x.urdf")));
   const Mechanism four = readOrFail(formatPath("four_bar_loop_joint.urdf"));
   EXPECT_FALSE(isOk(parseJointPositions("j1=1e155", four)));
   EXPECT_FALSE(isOk(makeJointPositions({"j1"}, {-1e13}, four)));
@@ -488,7 +559,8 @@ TEST(Numbers, TheJsonWriterRefusesInfAndNanAndNeverWritesThem) {
   EXPECT_FALSE(isOk(writeJson(inconsistent)));
 }
 
-// --- deep trees: read without recursion ------------------------------------------------------------------------------
+// --- deep trees: read without recursion
+// ------------------------------------------------------------------------------
 
 TEST(DeepTrees, AChainOfTwoHundredThousandLinksLoads) {
   constexpr int kLinks = 200000;
@@ -519,8 +591,8 @@ TEST(DeepTrees, AChainOfTwoHundredThousandLinksLoads) {
 }
 
 TEST(Readers, MjcfWeldHoldsTwoBodiesTogether) {
-  // Two cranks on parallel hinges, welded to each other: nothing moves. In the plane 3*2 - 2*2 - 3 = -1, so one
-  // equation is redundant; in space 6*2 - 5*2 - 6 = -4, four.
+  // Two cranks on parallel hinges, welded to each other: nothing moves. In the plane 3*2 - 2*2 - 3 = -1, so
+  // one equation is redundant; in space 6*2 - 5*2 - 6 = -4, four.
   const std::string path = ::testing::TempDir() + "weld.xml";
   std::ofstream(path) << R"(<mujoco model="weld"><worldbody>
   <body name="a"><joint name="ja" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.01"/></body>
@@ -556,7 +628,8 @@ TEST(Readers, ClosureFileNamesTypesAndFramesOfJoints) {
   // Same as the 3d closure file: DOF 3.
   EXPECT_EQ(reportOf(m, AnalysisMode::Auto).dof, 3);
   // Sizes that differ are named.
-  std::ofstream(yaml) << "closed_loop: [['closure_A', 'closure_B'], ['closure_A', 'crank_left']]\ntype: ['6d']\n";
+  std::ofstream(yaml)
+      << "closed_loop: [['closure_A', 'closure_B'], ['closure_A', 'crank_left']]\ntype: ['6d']\n";
   const Result<Mechanism> bad = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
   ASSERT_FALSE(isOk(bad));
   EXPECT_NE(diagnosticOf(bad).what.find("1 types for 2 closed_loop pairs"), std::string::npos);

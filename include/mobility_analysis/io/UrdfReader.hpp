@@ -18,7 +18,8 @@ namespace mobility_analysis {
  * - URDF+ `<loop name type><predecessor link><origin/></predecessor><successor link><origin/></successor>
  *   <axis/></loop>`, read as a loop joint with link1 = predecessor, link2 = successor;
  * - URDF+ `<coupling name><predecessor joint/><successor joint/><ratio value/></coupling>` (also
- *   `<leader joint>`/`<follower joint>`, optional `<offset value>`): successor = ratio * predecessor + offset;
+ *   `<leader joint>`/`<follower joint>`, optional `<offset value>`): successor = ratio * predecessor +
+ * offset;
  * - `<mimic joint multiplier offset/>` inside a tree joint: this joint = multiplier * that joint + offset, a
  *   coupling named "mimic_<this joint>".
  *

@@ -53,11 +53,13 @@ Result<Mechanism> addClosures(Mechanism mechanism, const YAML::Node& root, const
   const std::vector<std::string> names = stringList(root["joint_name"]);
   const std::vector<std::string> jointTypes = stringList(root["joint_type"]);
   if (types.size() != loops.size()) {
-    return error("yaml", "type",
-                 std::to_string(types.size()) + " types for " + std::to_string(loops.size()) + " closed_loop pairs");
+    return error(
+        "yaml", "type",
+        std::to_string(types.size()) + " types for " + std::to_string(loops.size()) + " closed_loop pairs");
   }
   for (size_t i = 0; i < loops.size(); ++i) {
-    const std::string name = i < names.size() && !names[i].empty() ? names[i] : "closed_loop_" + std::to_string(i);
+    const std::string name =
+        i < names.size() && !names[i].empty() ? names[i] : "closed_loop_" + std::to_string(i);
     const YAML::Node pair = loops[i];
     if (!pair.IsSequence() || pair.size() != 2 || !pair[0].IsScalar() || !pair[1].IsScalar())
       return error("closed_loop", name, "is not a pair [frameA, frameB]");
@@ -78,9 +80,9 @@ Result<Mechanism> addClosures(Mechanism mechanism, const YAML::Node& root, const
       if (jointTypes[i] == "SPHERICAL") {
         joint.type = JointType::Spherical;
       } else {
-        mechanism.warnings.push_back(makeDiagnostic(file, "closed_loop", name,
-                                                    "joint_type '" + jointTypes[i] + "' is not read; type '" +
-                                                        type + "' is used"));
+        mechanism.warnings.push_back(
+            makeDiagnostic(file, "closed_loop", name,
+                           "joint_type '" + jointTypes[i] + "' is not read; type '" + type + "' is used"));
       }
     }
     const std::string frames[2] = {pair[0].as<std::string>(), pair[1].as<std::string>()};

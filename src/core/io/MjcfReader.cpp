@@ -37,7 +37,9 @@ Eigen::Isometry3d bodyInParent(const mjModel& m, int body) {
 
 class MjcfConverter {
  public:
-  MjcfConverter(const mjModel& m, std::string file) : m_(m), file_(std::move(file)) { mechanism_.file = file_; }
+  MjcfConverter(const mjModel& m, std::string file) : m_(m), file_(std::move(file)) {
+    mechanism_.file = file_;
+  }
 
   Result<Mechanism> convert() {
     mechanism_.name = m_.nnames > 0 && m_.names != nullptr ? std::string(m_.names) : "mjcf";
@@ -130,10 +132,18 @@ class MjcfConverter {
         return d;
       joint.kind = ConnectionKind::TreeJoint;
       switch (m_.jnt_type[j]) {
-        case mjJNT_HINGE: joint.type = JointType::Revolute; break;
-        case mjJNT_SLIDE: joint.type = JointType::Prismatic; break;
-        case mjJNT_BALL: joint.type = JointType::Spherical; break;
-        default: joint.type = JointType::Floating; break;
+        case mjJNT_HINGE:
+          joint.type = JointType::Revolute;
+          break;
+        case mjJNT_SLIDE:
+          joint.type = JointType::Prismatic;
+          break;
+        case mjJNT_BALL:
+          joint.type = JointType::Spherical;
+          break;
+        default:
+          joint.type = JointType::Floating;
+          break;
       }
       if (axis.norm() < tolerances::kZeroVector)
         return makeDiagnostic(file_, "joint", joint.name, "axis is the zero vector");
@@ -171,9 +181,13 @@ class MjcfConverter {
   std::optional<Diagnostic> addEquality(int e) {
     const std::string name = equalityName(e);
     const int type = m_.eq_type[e];
-    const char* kind = type == mjEQ_CONNECT ? "connect" : type == mjEQ_WELD ? "weld" : type == mjEQ_JOINT ? "joint" : "equality";
+    const char* kind = type == mjEQ_CONNECT ? "connect"
+                       : type == mjEQ_WELD  ? "weld"
+                       : type == mjEQ_JOINT ? "joint"
+                                            : "equality";
     if (!m_.eq_active[e]) {
-      mechanism_.warnings.push_back(makeDiagnostic(file_, kind, name, "is inactive in the model and is not read"));
+      mechanism_.warnings.push_back(
+          makeDiagnostic(file_, kind, name, "is inactive in the model and is not read"));
       return std::nullopt;
     }
     const mjtNum* data = m_.eq_data + mjNEQDATA * e;
@@ -211,7 +225,8 @@ class MjcfConverter {
       const int leader = m_.eq_obj2id[e];
       if (leader < 0) {
         mechanism_.warnings.push_back(makeDiagnostic(
-            file_, kind, name, "has no joint2 (it holds '" + jointName(follower) + "' at a value) and is not read"));
+            file_, kind, name,
+            "has no joint2 (it holds '" + jointName(follower) + "' at a value) and is not read"));
         return std::nullopt;
       }
       auto oneFreedom = [&](int j) { return m_.jnt_type[j] == mjJNT_HINGE || m_.jnt_type[j] == mjJNT_SLIDE; };

@@ -1,9 +1,9 @@
 #include "mobility_analysis/io/ReadMechanism.hpp"
 
+#include <unistd.h>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "XmlValues.hpp"
 #include "mobility_analysis/io/ClosureFileReader.hpp"
@@ -31,8 +31,8 @@ std::string rootElement(const std::string& text) {
       continue;
     }
     size_t end = at + 1;
-    while (end < text.size() && text[end] != ' ' && text[end] != '>' && text[end] != '/' && text[end] != '\n' &&
-           text[end] != '\t' && text[end] != '\r')
+    while (end < text.size() && text[end] != ' ' && text[end] != '>' && text[end] != '/' &&
+           text[end] != '\n' && text[end] != '\t' && text[end] != '\r')
       ++end;
     return text.substr(at + 1, end - at - 1);
   }

@@ -30,8 +30,8 @@ const std::set<std::string> kIgnoredElements = {"gazebo",   "transmission", "ros
                                                 "material", "sensor",       "drake:collision_filter_group"};
 
 /// Top-level elements this reader understands.
-const std::set<std::string> kReadElements = {"link",  "joint", "loop_joint", "distance_constraint", "cable",
-                                             "loop", "coupling"};
+const std::set<std::string> kReadElements = {"link",  "joint", "loop_joint", "distance_constraint",
+                                             "cable", "loop",  "coupling"};
 
 /// @return @p name lower-cased without '_', '-' and ':', so a misspelt `<loopjoint>` can be pointed at.
 std::string squashed(const std::string& name) {
@@ -207,7 +207,8 @@ class Reader {
     return name;
   }
 
-  int link(const char* name, const std::string& kind, const std::string& element, const std::string& role) const {
+  int link(const char* name, const std::string& kind, const std::string& element,
+           const std::string& role) const {
     if (name == nullptr)
       fail(kind, element, "<" + role + "> has no link attribute");
     const auto it = links_.find(name);
@@ -248,7 +249,8 @@ class Reader {
   }
 
   void readLinks(const tinyxml2::XMLElement* robot) {
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e; e = e->NextSiblingElement("link")) {
+    for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e;
+         e = e->NextSiblingElement("link")) {
       const char* name = e->Attribute("name");
       if (name == nullptr || *name == '\0')
         fail("link", "", "has no name");
@@ -301,8 +303,9 @@ class Reader {
       joint.link1 = parentLink;
       joint.link2 = childLink;
       if (const tinyxml2::XMLElement* origin = e->FirstChildElement("origin")) {
-        joint.frame1 = io_detail::makeOriginFrame(vector(origin->Attribute("xyz"), "joint", name, "origin xyz"),
-                                                  vector(origin->Attribute("rpy"), "joint", name, "origin rpy"));
+        joint.frame1 =
+            io_detail::makeOriginFrame(vector(origin->Attribute("xyz"), "joint", name, "origin xyz"),
+                                       vector(origin->Attribute("rpy"), "joint", name, "origin rpy"));
       }
       if (joint.type != JointType::Fixed && joint.type != JointType::Floating)
         joint.axis = axis(e, "axis", "joint", name, Eigen::Vector3d::UnitX());
@@ -335,7 +338,8 @@ class Reader {
         continue;
       if (root >= 0) {
         fail("link", mechanism_.links[i].name,
-             "is not connected to the ground '" + mechanism_.links[root].name + "' by the <joint> tree (two roots)");
+             "is not connected to the ground '" + mechanism_.links[root].name +
+                 "' by the <joint> tree (two roots)");
       }
       root = static_cast<int>(i);
     }
@@ -361,9 +365,10 @@ class Reader {
     mechanism_.rootLink = root;
   }
 
-  /// One end of a loop element: <tag link xyz rpy/> (our dialect) or <tag link><origin xyz rpy/></tag> (URDF+).
-  std::pair<int, Eigen::Isometry3d> end(const tinyxml2::XMLElement* e, const char* tag, const std::string& kind,
-                                        const std::string& name) const {
+  /// One end of a loop element: <tag link xyz rpy/> (our dialect) or <tag link><origin xyz rpy/></tag>
+  /// (URDF+).
+  std::pair<int, Eigen::Isometry3d> end(const tinyxml2::XMLElement* e, const char* tag,
+                                        const std::string& kind, const std::string& name) const {
     const tinyxml2::XMLElement* endElement = e->FirstChildElement(tag);
     if (endElement == nullptr)
       fail(kind, name, std::string("missing <") + tag + ">");
@@ -416,7 +421,8 @@ class Reader {
     const char* type = e->Attribute("type");
     const std::optional<JointType> loopType = parseLoopType(type == nullptr ? "" : type);
     if (!loopType)
-      fail(kind, joint.name, "type '" + std::string(type == nullptr ? "" : type) + "' is not one of " + loopTypeList);
+      fail(kind, joint.name,
+           "type '" + std::string(type == nullptr ? "" : type) + "' is not one of " + loopTypeList);
     joint.type = *loopType;
     if (urdfPlus) {
       checkChildren(e, kind, joint.name, {"predecessor", "successor", "axis", "axis2", "limit", "dynamics"});
@@ -426,7 +432,8 @@ class Reader {
       readEnds(e, "link1", "link2", kind, joint);
     }
     if (needsAxis(joint.type) && e->FirstChildElement("axis") == nullptr) {
-      warn(kind, joint.name, std::string("type ") + toString(joint.type) + " has no <axis>; axis defaulted to 1 0 0");
+      warn(kind, joint.name,
+           std::string("type ") + toString(joint.type) + " has no <axis>; axis defaulted to 1 0 0");
     }
     if (joint.type == JointType::Universal && e->FirstChildElement("axis2") == nullptr) {
       warn(kind, joint.name, "type universal has no <axis2>; axis2 defaulted to 0 1 0");
@@ -443,13 +450,15 @@ class Reader {
     PendingCoupling coupling;
     coupling.kind = "coupling";
     coupling.name = elementName(e, "coupling");
-    checkChildren(e, "coupling", coupling.name, {"predecessor", "successor", "leader", "follower", "ratio", "offset"});
+    checkChildren(e, "coupling", coupling.name,
+                  {"predecessor", "successor", "leader", "follower", "ratio", "offset"});
     auto jointOf = [&](const char* first, const char* second) -> std::string {
       const tinyxml2::XMLElement* c = e->FirstChildElement(first);
       if (c == nullptr)
         c = e->FirstChildElement(second);
       if (c == nullptr)
-        fail("coupling", coupling.name, std::string("missing <") + first + " joint=\"...\"> (or <" + second + ">)");
+        fail("coupling", coupling.name,
+             std::string("missing <") + first + " joint=\"...\"> (or <" + second + ">)");
       const char* joint = c->Attribute("joint");
       if (joint == nullptr)
         fail("coupling", coupling.name, std::string("<") + c->Name() + "> has no joint attribute");
@@ -497,7 +506,7 @@ class Reader {
 
   std::string file_;
   Mechanism mechanism_;
-  std::unordered_map<std::string, int> links_;      ///< Link index by name (10^5 links: hashed).
+  std::unordered_map<std::string, int> links_;       ///< Link index by name (10^5 links: hashed).
   std::unordered_map<std::string, int> jointIndex_;  ///< Tree joint index by name.
   std::unordered_set<std::string> names_;            ///< Every connection name so far.
   std::vector<int> parentOf_;
