@@ -290,6 +290,13 @@ TEST(Couplings, GradientAndHessianMatchCentralDifferences) {
       Eigen::MatrixXd H;
       computeCouplingHessian(model.couplings[0], model, q, columns, H);
       ASSERT_EQ(H.rows(), static_cast<int>(columns.size()));
+      // The same through the form dispatcher every second-order user reads (EquationForms.hpp).
+      const Eigen::MatrixXd full = computeEquationHessian(model, q, row);
+      for (size_t a = 0; a < columns.size(); ++a) {
+        for (size_t b = 0; b < columns.size(); ++b)
+          EXPECT_DOUBLE_EQ(full(columns[a], columns[b]), H(a, b));
+      }
+      EXPECT_NEAR(full.norm(), H.norm(), 1e-12 * (1.0 + H.norm()));
       const double k = 1e-4;
       for (size_t a = 0; a < columns.size(); ++a) {
         for (size_t b = 0; b < columns.size(); ++b) {
