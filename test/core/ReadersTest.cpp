@@ -133,6 +133,10 @@ INSTANTIATE_TEST_SUITE_P(
                     "four_bar_loop_joint.urdf"},
         DialectCase{"five_bar_gepetto.urdf", "five_bar_6d.yaml", AnalysisMode::Auto, "planar", 2, 2, 0,
                     "five_bar_loop_joint.urdf"},
+        // Two 6d closures (a Watt six-bar with its closure frames on pins): the six-bar's numbers.
+        DialectCase{"six_bar_gepetto.urdf", "six_bar_6d.yaml", AnalysisMode::Auto, "planar", 1, 1, 0, ""},
+        DialectCase{"six_bar_gepetto.urdf", "six_bar_6d.yaml", AnalysisMode::Spatial, "spatial", 1, -5, 6,
+                    ""},
         // 3d: a ball at C, so in space: the five-bar's 2 plus closure_B spinning on its pin; 6*6-25-6-3 = 2.
         DialectCase{"five_bar_gepetto.urdf", "five_bar_3d.yaml", AnalysisMode::Auto, "spatial", 3, 2, 1, ""},
         // MJCF connect is a ball: 6*3 - 5*3 - 3 = 0, the planar motion makes one equation redundant.
