@@ -18,7 +18,8 @@ struct Diagnostic {
   std::string elementName;  ///< Name of the offending element; may be empty.
   std::string what;         ///< What is wrong, with expected vs got where sizes differ.
 
-  /// @return One line: "bennett.urdf: loop_joint 'j4': link2 'rockr' is not a link".
+  /// @return One line: "bennett.urdf: loop_joint 'j4': link2 'rockr' is not a link". Every field goes through
+  ///         escapeForLine, so a name or a third-party message with a newline still gives one line.
   std::string toString() const;
 };
 
@@ -49,6 +50,12 @@ template <class T>
 const Diagnostic& diagnosticOf(const Result<T>& result) {
   return std::get<Diagnostic>(result);
 }
+
+/**
+ * @brief Escapes what would break a one-line message: newline, carriage return and tab as \\n, \\r, \\t,
+ *        every other control character (and DEL) as \\xNN. Other bytes (UTF-8 included) pass unchanged.
+ */
+std::string escapeForLine(const std::string& text);
 
 /// Builds a Diagnostic in one expression.
 Diagnostic makeDiagnostic(std::string file, std::string elementKind, std::string elementName, std::string what);

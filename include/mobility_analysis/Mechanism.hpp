@@ -7,13 +7,26 @@
 
 #include <Eigen/Geometry>
 
+#include "mobility_analysis/Diagnostic.hpp"
+
 namespace mobility_analysis {
 
 /// Joint types of the closed-loop URDF dialect (DESIGN.md §2). `Planar` and `Floating` are URDF tree types.
-enum class JointType { Revolute, Continuous, Prismatic, Cylindrical, Spherical, Universal, Planar, Fixed, Floating };
+enum class JointType {
+  Revolute,
+  Continuous,
+  Prismatic,
+  Cylindrical,
+  Spherical,
+  Universal,
+  Planar,
+  Fixed,
+  Floating
+};
 
 /// Where a connection between two links comes from; also the order of its equations (DESIGN.md §3).
-enum class ConnectionKind { TreeJoint, DistanceConstraint, Cable, LoopJoint };
+/// A Coupling (URDF `<mimic>`, URDF+ `<coupling>`) ties two 1-DOF tree joints: one equation, after the loops.
+enum class ConnectionKind { TreeJoint, DistanceConstraint, Cable, LoopJoint, Coupling };
 
 /// Passive cables constrain while taut; active cables are the driver and constrain nothing.
 enum class CableType { Passive, Active };
@@ -24,7 +37,8 @@ struct Link {
 };
 
 /**
- * @brief One connection between two links: a URDF joint, a `loop_joint`, a `distance_constraint` or a `cable`.
+ * @brief One connection between two links: a URDF joint, a `loop_joint`, a `distance_constraint` or a
+ * `cable`.
  *
  * The joint frame is given on each side: `frame1` in link1's frame and `frame2` in link2's frame. For a tree
  * joint link1 is the parent, `frame1` the URDF origin and `frame2` the identity (the child frame is the joint
@@ -38,10 +52,16 @@ struct Joint {
   int link2 = -1;                     ///< Index into Mechanism::links (tree: child).
   Eigen::Isometry3d frame1 = Eigen::Isometry3d::Identity();  ///< Joint frame in link1's frame [m].
   Eigen::Isometry3d frame2 = Eigen::Isometry3d::Identity();  ///< Joint frame in link2's frame [m].
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();   ///< Unit axis in the joint frame.
-  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< Universal only: second unit axis, on link2.
-  double length = 0.0;                               ///< Cable: declared length [m]; else unused.
-  CableType cableType = CableType::Passive;          ///< Cable only.
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();           ///< Unit axis in the joint frame.
+  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();          ///< Universal only: second unit axis, on link2.
+  double length = 0.0;                                       ///< Cable: declared length [m]; else unused.
+  CableType cableType = CableType::Passive;                  ///< Cable only.
+  /// Coupling only: value(follower) = multiplier * value(leader) + offset [rad or m], both 1-DOF tree joints
+  /// (indices into Mechanism::joints). link1 is the follower's child, link2 the leader's child.
+  int leader = -1;
+  int follower = -1;
+  double multiplier = 1.0;
+  double offset = 0.0;
 };
 
 /// Joint values by tree-joint name [rad] or [m].
@@ -51,14 +71,18 @@ using JointPositions = std::map<std::string, double>;
  * @brief An immutable closed-loop mechanism as read from the URDF.
  *
  * `joints` holds every connection in the order of its constraint equations: tree joints in document order,
- * then distance constraints, then cables, then loop joints (DESIGN.md §3).
+ * then distance constraints, then cables, then loop joints, then couplings (DESIGN.md §3). Whatever format it
+ * was read from (io/ReadMechanism.hpp), nothing downstream knows.
  */
 struct Mechanism {
-  std::string name;             ///< URDF robot name.
-  std::string file;             ///< Source file name, for diagnostics.
-  std::vector<Link> links;      ///< Links in document order.
-  std::vector<Joint> joints;    ///< Connections in equation order.
-  int rootLink = 0;             ///< The ground.
+  std::string name;           ///< URDF robot name.
+  std::string file;           ///< Source file name, for diagnostics.
+  std::vector<Link> links;    ///< Links in document order.
+  std::vector<Joint> joints;  ///< Connections in equation order.
+  int rootLink = 0;           ///< The ground.
+  /// What the reader met but did not understand or had to assume (one Diagnostic each); copied into the
+  /// report's `warnings` by analyzeMechanism. A strict read turns the first into an error.
+  std::vector<Diagnostic> warnings;
 
   /// @return Index of the link called @p linkName, if any.
   std::optional<int> findLink(const std::string& linkName) const;
@@ -70,7 +94,7 @@ struct Mechanism {
 
 /// @return The dialect's spelling of @p type ("revolute", …).
 const char* toString(JointType type);
-/// @return "joint", "distance_constraint", "cable" or "loop_joint".
+/// @return "joint", "distance_constraint", "cable", "loop_joint" or "coupling".
 const char* toString(ConnectionKind kind);
 
 }  // namespace mobility_analysis

@@ -1,7 +1,10 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "mobility_analysis/Diagnostic.hpp"
 
 namespace mobility_analysis {
 
@@ -110,8 +113,26 @@ struct MobilityReport {
   std::vector<std::string> warnings;   ///< What was read but not understood (one line each).
 };
 
-/// @return The report as one JSON object (DESIGN.md §4), keys in a fixed order, numbers with 9 significant digits.
+/**
+ * @brief The report as one JSON object (DESIGN.md §4), keys in a fixed order, numbers with 9 significant digits.
+ * @note Never writes inf or nan (JSON has neither): a non-finite number becomes null. Callers that publish a
+ *       report use writeJson, which refuses such a report instead.
+ */
 std::string toJson(const MobilityReport& report);
+
+/**
+ * @brief The report's own invariants: every number finite, characteristic length positive,
+ *        num_coordinates - rank == dof, num_constraints - rank == num_redundant == |redundant_constraints|,
+ *        output_dof == finite_dof - passive_dof.
+ * @return Nothing when they hold, else the Diagnostic naming the first that does not.
+ */
+std::optional<Diagnostic> checkReport(const MobilityReport& report);
+
+/// @return toJson(report) once checkReport holds, else its Diagnostic: a report is only written when sound.
+Result<std::string> writeJson(const MobilityReport& report);
+
+/// @return toText(report) once checkReport holds, else its Diagnostic.
+Result<std::string> writeText(const MobilityReport& report);
 
 /// @return The readable report the CLI prints by default.
 std::string toText(const MobilityReport& report);

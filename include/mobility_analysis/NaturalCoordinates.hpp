@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "mobility_analysis/CouplingEquation.hpp"
 #include "mobility_analysis/Diagnostic.hpp"
 #include "mobility_analysis/JointTypes.hpp"
 #include "mobility_analysis/Kinematics.hpp"
@@ -50,6 +51,7 @@ enum class EquationForm {
   Combination,  ///< (x_target - x_origin - c0 d1 - c1 d2 - c2 d1 x d2)_component; planar: d2 := J d1, no c2
                 ///< term
   Triple,       ///< (a x b).c - value (space only)
+  Coupling,     ///< v_f(q) - m v_l(q) - c, CoordinateModel::couplings[coupling] (CouplingEquation.hpp)
 };
 
 /// What an equation means, for names and for tests.
@@ -65,7 +67,8 @@ enum class EquationKind {
   AxisAngle,
   PointInPlane,
   Distance,
-  FixedCoordinate
+  FixedCoordinate,
+  Coupling
 };
 /// @return "distance", "unit_norm", … (snake_case, as in the JSON report).
 const char* toString(EquationKind kind);
@@ -84,6 +87,7 @@ struct ConstraintEquation {
   Direction d1, d2;  ///< Combination: the body's basis directions (planar: d2 unused).
   Eigen::Vector3d coefficients = Eigen::Vector3d::Zero();  ///< Combination: c0, c1, c2.
   double value = 0.0;                                      ///< Dot, Cross, Component: the constant.
+  int coupling = -1;  ///< Coupling: index into CoordinateModel::couplings.
 };
 
 /// The mechanism in natural coordinates: elements, their coordinates at the assembled pose and the equations.
@@ -97,6 +101,7 @@ struct CoordinateModel {
   double characteristicLength = 1.0;  ///< [m] lengths are divided by it.
   std::vector<Element> elements;
   std::vector<ConstraintEquation> equations;  ///< In contract order: links, joints, boundary.
+  std::vector<CouplingTerms> couplings;       ///< The operands of the Coupling equations.
   std::vector<int> jointFreedom;  ///< F_i of each connection in this mode (-1: ignored, e.g. slack cable).
   std::vector<bool> jointActive;  ///< Whether a connection contributes equations (cables: taut passive).
   std::vector<std::vector<int>> bodyElements;  ///< Element indices of each link.

@@ -49,6 +49,11 @@ constexpr double kZeroVector = 1e-12;
 /// (cosine) of their angle is below this [-].
 constexpr double kPlanarAxis = 1e-6;
 
+/// Largest magnitude accepted for any length, position or joint value read from a model or given by a caller
+/// [m] or [rad]: beyond it squares overflow or lose every digit of the mechanism's own size (a coordinate of
+/// 1e155 makes the characteristic length inf). Input outside |x| <= kMaxCoordinate is refused where it enters.
+constexpr double kMaxCoordinate = 1e12;
+
 /// A passive cable is taut when |distance - length| is below this fraction of its length [-].
 constexpr double kCableTaut = 1e-6;
 

@@ -10,9 +10,8 @@ namespace mobility_analysis {
 /**
  * @brief Reads a closed-loop URDF (DESIGN.md §2) from text.
  *
- * urdfdom reads the `<joint>` tree; the same XML is read with tinyxml2 for `<loop_joint>`,
- * `<distance_constraint>` and `<cable>`. Checks what urdfdom does not: a link with two parents, links not
- * connected to the root, unknown links, duplicate names, zero or non-finite axes and numbers.
+ * The URDF reader of io/UrdfReader.hpp (every loop dialect; warnings in Mechanism::warnings, not strict);
+ * io/ReadMechanism.hpp is the front door for every format and for strict reading.
  * @param[in] urdfText the XML text.
  * @param[in] fileName shown in diagnostics (may be a description such as "robot_description").
  * @return The mechanism, or the Diagnostic naming the element and the problem.
@@ -31,7 +30,7 @@ Result<JointPositions> parseJointPositions(const std::string& text, const Mechan
 /**
  * @brief Checks joint names and values (as given to the services) against @p mechanism.
  * @return The positions, or a Diagnostic: sizes differ ("3 values for 4 joint_names"), unknown joint,
- *         joint that has no single value (loop, fixed, floating), non-finite value.
+ *         joint that has no single value (loop, fixed, floating), non-finite value or |value| > 1e12.
  */
 Result<JointPositions> makeJointPositions(const std::vector<std::string>& names, const std::vector<double>& values,
                                           const Mechanism& mechanism);

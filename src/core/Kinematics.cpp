@@ -76,6 +76,16 @@ JointPositions computeJointPositions(const Mechanism& mechanism, const LinkPoses
 
 double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int jointIndex, double lengthScale) {
   const Joint& joint = mechanism.joints[jointIndex];
+  if (joint.kind == ConnectionKind::Coupling) {
+    // value(follower) - multiplier value(leader) - offset, in the follower's unit.
+    const JointPositions values = computeJointPositions(mechanism, poses);
+    auto value = [&](int j) {
+      const auto it = values.find(mechanism.joints[j].name);
+      return it == values.end() ? 0.0 : it->second;
+    };
+    const double residual = std::abs(value(joint.follower) - joint.multiplier * value(joint.leader) - joint.offset);
+    return mechanism.joints[joint.follower].type == JointType::Prismatic ? residual : lengthScale * residual;
+  }
   if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
       joint.type == JointType::Floating) {
     return 0.0;  // a distance constraint takes its length from the pose; cables are checked for tautness
@@ -106,7 +116,7 @@ double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, 
 double computeCharacteristicLength(const Mechanism& mechanism, const LinkPoses& poses) {
   std::vector<Eigen::Vector3d> points;
   for (const Joint& joint : mechanism.joints) {
-    if (joint.type == JointType::Floating) {
+    if (joint.type == JointType::Floating || joint.kind == ConnectionKind::Coupling) {
       continue;
     }
     points.push_back(poses[joint.link1] * joint.frame1.translation());

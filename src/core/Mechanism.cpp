@@ -31,25 +31,40 @@ std::optional<int> Mechanism::findParentJoint(int link) const {
 
 const char* toString(JointType type) {
   switch (type) {
-    case JointType::Revolute: return "revolute";
-    case JointType::Continuous: return "continuous";
-    case JointType::Prismatic: return "prismatic";
-    case JointType::Cylindrical: return "cylindrical";
-    case JointType::Spherical: return "spherical";
-    case JointType::Universal: return "universal";
-    case JointType::Planar: return "planar";
-    case JointType::Fixed: return "fixed";
-    case JointType::Floating: return "floating";
+    case JointType::Revolute:
+      return "revolute";
+    case JointType::Continuous:
+      return "continuous";
+    case JointType::Prismatic:
+      return "prismatic";
+    case JointType::Cylindrical:
+      return "cylindrical";
+    case JointType::Spherical:
+      return "spherical";
+    case JointType::Universal:
+      return "universal";
+    case JointType::Planar:
+      return "planar";
+    case JointType::Fixed:
+      return "fixed";
+    case JointType::Floating:
+      return "floating";
   }
   return "unknown";
 }
 
 const char* toString(ConnectionKind kind) {
   switch (kind) {
-    case ConnectionKind::TreeJoint: return "joint";
-    case ConnectionKind::DistanceConstraint: return "distance_constraint";
-    case ConnectionKind::Cable: return "cable";
-    case ConnectionKind::LoopJoint: return "loop_joint";
+    case ConnectionKind::TreeJoint:
+      return "joint";
+    case ConnectionKind::DistanceConstraint:
+      return "distance_constraint";
+    case ConnectionKind::Cable:
+      return "cable";
+    case ConnectionKind::LoopJoint:
+      return "loop_joint";
+    case ConnectionKind::Coupling:
+      return "coupling";
   }
   return "unknown";
 }

@@ -58,6 +58,8 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   MobilityReport& report = analysis.report;
   report.robot = mechanism.name;
   report.file = mechanism.file;
+  for (const Diagnostic& warning : mechanism.warnings)
+    report.warnings.push_back(warning.toString());
   report.mode = toString(model.mode);
   report.lambda = model.lambda;
   report.dof = ranks.dof();
@@ -111,7 +113,11 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
       ++jointEquations[eq.element];
     if (!ranks.redundant[r])
       continue;
-    report.redundantConstraints.push_back(RedundantConstraint{r, toString(eq.source), elementName(eq),
+    // A coupling's equation is a joint equation in the phases, but the report names its own source kind.
+    const bool coupling =
+        eq.source == EquationSource::Joint && mechanism.joints[eq.element].kind == ConnectionKind::Coupling;
+    report.redundantConstraints.push_back(RedundantConstraint{r, coupling ? "coupling" : toString(eq.source),
+                                                              elementName(eq),
                                                               toString(eq.kind), describeEquation(model, r)});
     // Only the design makes joints and ground constraints redundant, not a pose.
     if (finite.configurationCause[r]) {

@@ -1,5 +1,6 @@
 #include "mobility_analysis/MobilityReport.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -37,8 +38,11 @@ std::string quote(const std::string& text) {
   return out + "\"";
 }
 
-/// Numbers with a fixed number of significant digits, so equal reports print equal text.
+/// Numbers with a fixed number of significant digits, so equal reports print equal text. JSON has no inf or
+/// nan: a non-finite number is written as null (writeJson refuses such a report before it gets here).
 std::string number(double value, int digits = 9) {
+  if (!std::isfinite(value))
+    return "null";
   char text[40];
   std::snprintf(text, sizeof(text), "%.*g", digits, value);
   return text;
@@ -205,6 +209,64 @@ std::string toText(const MobilityReport& r) {
   for (size_t i = 0; i < r.assembly.events.size(); ++i) out << (i ? "; " : "") << r.assembly.events[i];
   out << "\n";
   return out.str();
+}
+
+std::optional<Diagnostic> checkReport(const MobilityReport& r) {
+  auto refuse = [&](const std::string& what) {
+    return makeDiagnostic(r.file, "report", r.robot, what + "; the report is not written");
+  };
+  auto finite = [&](double value, const std::string& field) -> std::optional<Diagnostic> {
+    if (std::isfinite(value))
+      return std::nullopt;
+    return refuse(field + " is " + (std::isnan(value) ? "nan" : "inf"));
+  };
+  std::vector<std::pair<double, std::string>> numbers = {
+      {r.characteristicLength, "characteristic_length"},
+      {r.closureResidualBefore, "closure_residual.before"},
+      {r.closureResidualAfter, "closure_residual.after"},
+      {r.rankMargin.tolerance, "rank_margin.tolerance"},
+      {r.rankMargin.smallestKeptPivot, "rank_margin.smallest_kept_pivot"},
+      {r.rankMargin.largestDroppedResidual, "rank_margin.largest_dropped_residual"},
+      {r.assembly.residual, "assembly.residual"}};
+  for (const CableState& c : r.cables) {
+    numbers.emplace_back(c.length, "cable " + c.name + " length");
+    numbers.emplace_back(c.distance, "cable " + c.name + " distance");
+  }
+  for (const JointValue& p : r.positions)
+    numbers.emplace_back(p.value, "position of " + p.name);
+  for (const auto& [value, field] : numbers) {
+    if (std::optional<Diagnostic> d = finite(value, field))
+      return d;
+  }
+  if (!(r.characteristicLength > 0.0))
+    return refuse("characteristic_length is not positive");
+  if (r.rank < 0 || r.rank > r.numCoordinates || r.rank > r.numConstraints)
+    return refuse("rank " + std::to_string(r.rank) + " is outside [0, min(num_coordinates, num_constraints)]");
+  if (r.numCoordinates - r.rank != r.dof) {
+    return refuse("num_coordinates - rank = " + std::to_string(r.numCoordinates - r.rank) + " but dof is " +
+                  std::to_string(r.dof));
+  }
+  if (r.numConstraints - r.rank != r.numRedundant ||
+      static_cast<size_t>(r.numRedundant) != r.redundantConstraints.size()) {
+    return refuse("num_redundant " + std::to_string(r.numRedundant) + ", redundant_constraints " +
+                  std::to_string(r.redundantConstraints.size()) + " and num_constraints - rank " +
+                  std::to_string(r.numConstraints - r.rank) + " differ");
+  }
+  if (r.finiteDof < 0 || r.passiveDof < 0 || r.outputDof != r.finiteDof - r.passiveDof)
+    return refuse("finite_dof, passive_dof and output_dof are inconsistent");
+  return std::nullopt;
+}
+
+Result<std::string> writeJson(const MobilityReport& report) {
+  if (std::optional<Diagnostic> d = checkReport(report))
+    return *d;
+  return toJson(report);
+}
+
+Result<std::string> writeText(const MobilityReport& report) {
+  if (std::optional<Diagnostic> d = checkReport(report))
+    return *d;
+  return toText(report);
 }
 
 }  // namespace mobility_analysis

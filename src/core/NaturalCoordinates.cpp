@@ -70,6 +70,8 @@ const char* toString(EquationKind kind) {
       return "distance_constraint";
     case EquationKind::FixedCoordinate:
       return "fixed_coordinate";
+    case EquationKind::Coupling:
+      return "coupling";
   }
   return "unknown";
 }
@@ -87,7 +89,8 @@ bool isSpatialOnly(JointType type) {
 Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const LinkPoses& poses) {
   std::vector<Eigen::Vector3d> slides;
   for (const Joint& joint : mechanism.joints) {
-    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable)
+    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
+        joint.kind == ConnectionKind::Coupling)
       continue;
     const Eigen::Vector3d axis = worldAxes(joint, poses).first;
     if (joint.type == JointType::Revolute || joint.type == JointType::Continuous)
@@ -114,13 +117,15 @@ Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const LinkPoses& pos
 std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const LinkPoses& poses) {
   for (const Joint& joint : mechanism.joints) {
     if (joint.kind != ConnectionKind::DistanceConstraint && joint.kind != ConnectionKind::Cable &&
+        joint.kind != ConnectionKind::Coupling &&
         isSpatialOnly(joint.type)) {
       return std::nullopt;
     }
   }
   const Eigen::Vector3d normal = candidateNormal(mechanism, poses);
   for (const Joint& joint : mechanism.joints) {
-    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable)
+    if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
+        joint.kind == ConnectionKind::Coupling)
       continue;
     const auto axes = worldAxes(joint, poses);
     if (classifyPlanar(joint, axes.first, axes.second, normal) == PlanarForm::Invalid) {
@@ -272,6 +277,15 @@ std::string describeEquation(const CoordinateModel& model, int row) {
     case EquationKind::FixedCoordinate:
       return label(eq.a.head) + "_" + kAxisNames[eq.component] + " = " + number(eq.value) +
              (model.elements[eq.a.head].isPoint ? " Lc" : "");
+    case EquationKind::Coupling: {
+      const CouplingTerms& terms = model.couplings[eq.coupling];
+      auto value = [&](const JointValueOperand& o) {
+        return o.prismatic ? "s(" + label(o.aHead) + " -> " + label(o.bHead) + ")"
+                           : "angle(" + label(o.aHead) + ", " + label(o.bHead) + ")";
+      };
+      return value(terms.follower) + " = " + number(terms.multiplier) + " " + value(terms.leader) + " + " +
+             number(terms.offset) + (terms.follower.prismatic ? " Lc" : " rad");
+    }
     default:
       break;
   }

@@ -194,9 +194,21 @@ class LocalStressFinder {
 SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
                                        const SparseJacobian& J, double tolerance,
                                        const ProgressCallback& progress) {
-  const EliminationOrder order = computeSweepOrder(mechanism, model);
+  EliminationOrder order = computeSweepOrder(mechanism, model);
   const int m = static_cast<int>(J.rows());
   const int n = static_cast<int>(J.cols());
+  // A tree (only tree joints carry equations) has no loop for a stress to close, but swept from the ground every
+  // reduced row is written in the free coordinates of all the links above it: the fill, and the time, grow as
+  // the square of its depth (a 2 10^5-link chain ran out of memory). Swept from the leaves instead, each link's
+  // rows pivot on its own coordinates before its parent's are seen, and nothing fills in.
+  const bool tree = std::all_of(mechanism.joints.begin(), mechanism.joints.end(), [&](const Joint& joint) {
+    return joint.kind == ConnectionKind::TreeJoint;
+  });
+  if (tree) {
+    std::reverse(order.rows.begin(), order.rows.end());
+    for (int& priority : order.columnPriority)
+      priority = n - 1 - priority;
+  }
   std::vector<int> position(m, 0);
   for (size_t i = 0; i < order.rows.size(); ++i)
     position[order.rows[i]] = static_cast<int>(i);

@@ -1,6 +1,7 @@
-/// mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] [--rank-tolerance T]
-/// [--json] Prints the mobility report of a closed-loop URDF, with the --positions joints held at their values;
-/// on bad input one line on stderr and exit code 2.
+/// mobility_report FILE [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1]
+/// [--rank-tolerance T] [--json] Prints the mobility report of a closed-loop URDF or an MJCF model, with the
+/// --positions joints held at their values; warnings go
+/// to stderr as "warning: ..." lines; on bad input one line on stderr and exit code 2.
 
 #include <chrono>
 #include <cstdlib>
@@ -20,8 +21,8 @@ int fail(const std::string& line) {
 }
 
 const char* kUsage =
-    "usage: mobility_report FILE.urdf [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1] "
-    "[--rank-tolerance T] [--json]";
+    "usage: mobility_report FILE.urdf|FILE.xml [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] "
+    "[--positions j1=0.3,j2=-1] [--rank-tolerance T] [--json]";
 
 /// --help: the usage line and what --positions does (errors print the usage line alone: one line).
 const char* kPositionsHelp =
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
     std::string file, modeText = "auto", positionsText;
     double rankTolerance = -1.0;
     bool json = false;
+    ReadOptions readOptions;
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
       auto next = [&](const std::string& option) -> const char* {
@@ -46,12 +48,16 @@ int main(int argc, char** argv) {
       };
       if (arg == "--json") {
         json = true;
-      } else if (arg == "--mode" || arg == "--positions" || arg == "--rank-tolerance") {
+      } else if (arg == "--strict") {
+        readOptions.strict = true;
+      } else if (arg == "--mode" || arg == "--positions" || arg == "--rank-tolerance" || arg == "--closures") {
         const char* value = next(arg);
         if (value == nullptr)
           return fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage);
         if (arg == "--mode")
           modeText = value;
+        if (arg == "--closures")
+          readOptions.closuresFile = value;
         if (arg == "--positions")
           positionsText = value;
         if (arg == "--rank-tolerance") {
@@ -74,7 +80,7 @@ int main(int argc, char** argv) {
       }
     }
     if (file.empty())
-      return fail(std::string("mobility_report: no URDF file given; ") + kUsage);
+      return fail(std::string("mobility_report: no model file given; ") + kUsage);
 
     const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
     if (!isOk(mode))
@@ -84,9 +90,11 @@ int main(int argc, char** argv) {
     auto elapsed = [start] {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
-    const Result<Mechanism> mechanism = loadMechanismFromFile(file);
+    const Result<Mechanism> mechanism = readMechanism(file, readOptions);
     if (!isOk(mechanism))
       return fail(diagnosticOf(mechanism).toString());
+    for (const Diagnostic& warning : valueOf(mechanism).warnings)
+      std::cerr << "warning: " << warning.toString() << std::endl;
     if (elapsed() > 1.0) {
       std::cerr << "mobility_report: loaded " << valueOf(mechanism).links.size() << " links and "
                 << valueOf(mechanism).joints.size() << " connections (" << elapsed() << " s)" << std::endl;
@@ -110,7 +118,12 @@ int main(int argc, char** argv) {
     const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
     if (!isOk(analysis))
       return fail(diagnosticOf(analysis).toString());
-    std::cout << (json ? toJson(valueOf(analysis).report) : toText(valueOf(analysis).report));
+    // The report is written only once its own invariants hold (finite numbers, consistent counts).
+    const Result<std::string> out =
+        json ? writeJson(valueOf(analysis).report) : writeText(valueOf(analysis).report);
+    if (!isOk(out))
+      return fail(diagnosticOf(out).toString());
+    std::cout << valueOf(out);
     return 0;
   } catch (const std::exception& e) {
     return fail(std::string("mobility_report: internal error: ") + e.what());

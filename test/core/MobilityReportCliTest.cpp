@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <regex>
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -34,6 +36,13 @@ CliRun runReport(const std::string& arguments) {
   return run;
 }
 
+std::string readTextFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 }  // namespace
 
 TEST(MobilityReportCli, JsonEqualsTheCoreReport) {
@@ -60,7 +69,10 @@ TEST(MobilityReportCli, BadInputExitsTwoWithOneLineAndNoReport) {
       {fixturePath("four_bar_closed.urdf") + " --positions jx=1", "jx"},
       {fixturePath("four_bar_closed.urdf") + " --bogus", "--bogus"},
       {"/nonexistent.urdf", "nonexistent"},
-      {"", "no URDF file"},
+      {"", "no model file"},
+      {fixturePath("four_bar_closed.urdf") + " --positions j1=1e155", "outside the accepted range"},
+      {fixturePath("formats/five_bar_gepetto.urdf") + " --closures /nonexistent.yaml", "nonexistent.yaml"},
+      {fixturePath("formats/five_bar_gepetto.urdf") + " --closures", "--closures needs a value"},
   };
   for (const auto& [arguments, expected] : cases) {
     const CliRun run = runReport(arguments);
@@ -75,4 +87,97 @@ TEST(MobilityReportCli, PlanarModeOnASpatialMechanismNamesTheJoint) {
   const CliRun run = runReport(urdfPath("bennett.urdf") + " --mode planar");
   EXPECT_EQ(run.status, 2);
   EXPECT_NE(run.err.find("does not allow motion in the plane"), std::string::npos) << run.err;
+}
+
+namespace {
+
+std::string writeFile(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+int jsonInt(const std::string& json, const std::string& key) {
+  const size_t at = json.find("\"" + key + "\": ");
+  return at == std::string::npos ? -99999 : std::stoi(json.substr(at + key.size() + 4));
+}
+
+}  // namespace
+
+TEST(MobilityReportCli, ReadsEveryFormatThroughOneFrontDoor) {
+  struct Case {
+    std::string arguments;
+    int dof;
+  };
+  const std::vector<Case> cases = {
+      {fixturePath("formats/four_bar_urdfplus.urdf"), 1},
+      {fixturePath("formats/four_bar_drake.urdf"), 1},
+      {fixturePath("formats/six_bar_urdfplus.urdf"), 1},
+      {fixturePath("formats/five_bar_gepetto.urdf") + " --closures " + fixturePath("formats/five_bar_6d.yaml"), 2},
+      {fixturePath("formats/four_bar_mjcf.xml"), 1},
+      {fixturePath("formats/leg_mjcf.xml"), 2},
+      {fixturePath("formats/gripper_mimic.urdf") + " --mode spatial", 1},
+  };
+  for (const Case& c : cases) {
+    const CliRun run = runReport(c.arguments + " --json --strict");
+    EXPECT_EQ(run.status, 0) << c.arguments << ": " << run.err;
+    EXPECT_TRUE(run.err.empty()) << run.err;
+    EXPECT_EQ(jsonInt(run.out, "dof"), c.dof) << c.arguments;
+  }
+}
+
+TEST(MobilityReportCli, WarningsGoToStderrAndStrictMakesThemErrors) {
+  const std::string path = writeFile(
+      "typo.urdf",
+      "<robot name='typo'><link name='g'/><link name='a'/><link name='b'/>"
+      "<joint name='ja' type='revolute'><parent link='g'/><child link='a'/><axis xyz='0 0 1'/></joint>"
+      "<joint name='jb' type='revolute'><parent link='a'/><child link='b'/><origin xyz='1 0 0'/><axis xyz='0 0 1'/>"
+      "</joint><loopjoint name='j4' type='revolute'><link1 link='b' xyz='1 0 0'/><link2 link='g' xyz='1 0 0'/>"
+      "</loopjoint></robot>");
+  const CliRun loose = runReport(path + " --json");
+  EXPECT_EQ(loose.status, 0) << loose.err;
+  EXPECT_EQ(loose.err.rfind("warning: typo.urdf: loopjoint 'j4': unknown element <loopjoint>", 0), 0u) << loose.err;
+  EXPECT_EQ(std::count(loose.err.begin(), loose.err.end(), '\n'), 1) << loose.err;
+  EXPECT_NE(loose.out.find("did you mean <loop_joint>"), std::string::npos);  // and in the JSON's warnings
+  const CliRun strict = runReport(path + " --strict --json");
+  EXPECT_EQ(strict.status, 2);
+  EXPECT_TRUE(strict.out.empty());
+  EXPECT_NE(strict.err.find("--strict"), std::string::npos) << strict.err;
+  EXPECT_EQ(std::count(strict.err.begin(), strict.err.end(), '\n'), 1) << strict.err;
+}
+
+TEST(MobilityReportCli, HostileNamesAndExtremeNumbersGiveOneLine) {
+  const std::string text = readTextFile(fixturePath("formats/four_bar_loop_joint.urdf"));
+  const std::vector<std::string> inputs = {
+      std::regex_replace(text, std::regex("xyz=\"0.4 0 0\""), "xyz=\"1 0 1e308\""),
+      std::regex_replace(text, std::regex("link2 link=\"rocker\""), "link2 link=\"gro&#10;und\x01\""),
+      std::regex_replace(text, std::regex("<\\?xml version=\"1.0\"\\?>"), "<?xml version=\"1.0\n\x02"),
+  };
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    const std::string path = writeFile("hostile" + std::to_string(i) + ".urdf", inputs[i]);
+    const CliRun run = runReport(path + " --json");
+    EXPECT_EQ(run.status, 2) << inputs[i];
+    EXPECT_TRUE(run.out.empty());
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    for (size_t k = 0; k + 1 < run.err.size(); ++k)
+      EXPECT_GE(static_cast<unsigned char>(run.err[k]), 0x20) << run.err;
+  }
+}
+
+TEST(MobilityReportCli, AChainOfTwoHundredThousandLinksReportsItsDof) {
+  // urdfdom walked the tree recursively and crashed past ~130 000 links; the reader is iterative and a tree is
+  // eliminated from its leaves, so the whole report stays linear.
+  constexpr int kLinks = 200000;
+  std::string text = "<robot name='chain'><link name='l0'/>";
+  text.reserve(static_cast<size_t>(kLinks) * 160);
+  for (int i = 1; i <= kLinks; ++i) {
+    const std::string n = std::to_string(i), p = std::to_string(i - 1);
+    text += "<link name='l" + n + "'/><joint name='j" + n + "' type='revolute'><parent link='l" + p +
+            "'/><child link='l" + n + "'/><origin xyz='0.1 0 0'/><axis xyz='0 0 1'/></joint>";
+  }
+  text += "</robot>";
+  const CliRun run = runReport(writeFile("chain.urdf", text) + " --json");
+  EXPECT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(jsonInt(run.out, "dof"), kLinks);
+  EXPECT_EQ(jsonInt(run.out, "num_redundant"), 0);
 }

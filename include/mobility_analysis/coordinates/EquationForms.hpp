@@ -41,6 +41,11 @@ class ElementView {
   const CoordinateModel& model_;
   Eigen::Ref<const Eigen::VectorXd> q_;  ///< A view (by value: a view of a temporary would dangle).
   int dim_;
+
+ public:
+  /// The model and coordinates viewed (the coupling form reads its operands and differentiates through q).
+  const CoordinateModel& model() const { return model_; }
+  const Eigen::Ref<const Eigen::VectorXd>& q() const { return q_; }
 };
 
 /// Receives one equation's gradient: (column, value); repeated columns are summed by the receiver.
@@ -124,6 +129,14 @@ struct TripleForm {
   static void gradient(const ElementView& v, const ConstraintEquation& eq, int row, GradientSink& sink);
   static void hessian(const ElementView& v, const ConstraintEquation& eq, double weight, HessianSink& sink);
 };
+/// v_f(q) - m v_l(q) - c, two joint values read as angles between bodies' directions (CouplingEquation.hpp):
+/// not polynomial, so its Hessian depends on q.
+struct CouplingForm {
+  static constexpr bool kConstantHessian = false;
+  static double value(const ElementView& v, const ConstraintEquation& eq);
+  static void gradient(const ElementView& v, const ConstraintEquation& eq, int row, GradientSink& sink);
+  static void hessian(const ElementView& v, const ConstraintEquation& eq, double weight, HessianSink& sink);
+};
 /** @} */
 
 /**
@@ -143,6 +156,8 @@ decltype(auto) visitForm(EquationForm form, Visitor&& visitor) {
       return visitor(CombinationForm{});
     case EquationForm::Triple:
       return visitor(TripleForm{});
+    case EquationForm::Coupling:
+      return visitor(CouplingForm{});
   }
   return visitor(ComponentForm{});  // unreachable: every enumerator has a case
 }

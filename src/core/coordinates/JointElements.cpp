@@ -40,6 +40,10 @@ std::optional<Diagnostic> addJointElements(ModelBuilder& builder) {
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     const Joint& joint = mechanism.joints[j];
     ConnectionElements& c = builder.connections[j];
+    if (joint.kind == ConnectionKind::Coupling) {
+      model.jointFreedom[j] = model.lambda - 1;  // one equation on the elements of the two joints it couples
+      continue;
+    }
     const auto axes = worldAxes(joint, builder.poses);
     c.axisWorld = axes.first;
     // The connection's primitives in this mode: the joint-type table (JointTypes.cpp), or its planar form.

@@ -1,5 +1,6 @@
 #include <cmath>
 
+#include "mobility_analysis/CouplingEquation.hpp"
 #include "mobility_analysis/coordinates/ModelBuilder.hpp"
 
 namespace mobility_analysis {
@@ -227,6 +228,10 @@ void addJointEquations(ModelBuilder& builder) {
   for (size_t j = 0; j < builder.mechanism.joints.size(); ++j) {
     if (!builder.model.jointActive[j])
       continue;
+    if (builder.mechanism.joints[j].kind == ConnectionKind::Coupling) {
+      addCouplingEquation(builder, static_cast<int>(j));  // CouplingEquation.hpp
+      continue;
+    }
     const JointContext context{builder, static_cast<int>(j), builder.connections[j]};
     for (Primitive primitive : builder.connections[j].primitives)
       writerOf(primitive)(context);

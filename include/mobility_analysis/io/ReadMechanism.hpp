@@ -1,0 +1,35 @@
+#pragma once
+
+#include <string>
+
+#include "mobility_analysis/Diagnostic.hpp"
+#include "mobility_analysis/Mechanism.hpp"
+
+namespace mobility_analysis {
+
+/// How a model is read.
+struct ReadOptions {
+  std::string closuresFile;  ///< A Pinocchio/Gepetto closure file (robot.yaml) for a URDF; empty: none.
+  bool strict = false;       ///< Every warning is an error (the first one is returned).
+};
+
+/**
+ * @brief The one front door of the readers: a URDF in any of our dialects (io/UrdfReader.hpp), plus a closure
+ *        file if given (io/ClosureFileReader.hpp), or an MJCF model (io/MjcfReader.hpp).
+ *
+ * The format is told by the root element (`<robot>`: URDF, `<mujoco>`: MJCF), not by the extension.
+ * @param[in] path the model file.
+ * @param[in] options closure file and strictness.
+ * @return The mechanism with its warnings, or a Diagnostic (in strict mode: the first warning).
+ */
+Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& options = {});
+
+/**
+ * @brief The same from text (the node's `robot_description` and `~load_robot`): URDF or MJCF.
+ * @param[in] text the XML.
+ * @param[in] sourceName shown in diagnostics ("robot_description").
+ */
+Result<Mechanism> readMechanismFromString(const std::string& text, const std::string& sourceName,
+                                          const ReadOptions& options = {});
+
+}  // namespace mobility_analysis

@@ -1,0 +1,105 @@
+#include "mobility_analysis/io/ReadMechanism.hpp"
+
+#include <unistd.h>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "XmlValues.hpp"
+#include "mobility_analysis/io/ClosureFileReader.hpp"
+#include "mobility_analysis/io/MjcfReader.hpp"
+#include "mobility_analysis/io/UrdfReader.hpp"
+
+namespace mobility_analysis {
+
+namespace {
+
+/// The name of the document's root element, after the XML declaration, comments and doctype; "" if none.
+std::string rootElement(const std::string& text) {
+  size_t at = 0;
+  while (true) {
+    at = text.find('<', at);
+    if (at == std::string::npos || at + 1 >= text.size())
+      return "";
+    const char next = text[at + 1];
+    if (next == '?' || next == '!') {
+      const bool comment = text.compare(at, 4, "<!--") == 0;
+      const size_t close = comment ? text.find("-->", at) : text.find('>', at);
+      if (close == std::string::npos)
+        return "";
+      at = close + 1;
+      continue;
+    }
+    size_t end = at + 1;
+    while (end < text.size() && text[end] != ' ' && text[end] != '>' && text[end] != '/' &&
+           text[end] != '\n' && text[end] != '\t' && text[end] != '\r')
+      ++end;
+    return text.substr(at + 1, end - at - 1);
+  }
+}
+
+Result<Mechanism> finish(Result<Mechanism> mechanism, const ReadOptions& options) {
+  if (!isOk(mechanism))
+    return mechanism;
+  if (!options.closuresFile.empty()) {
+    mechanism = addClosureFile(valueOf(std::move(mechanism)), options.closuresFile);
+    if (!isOk(mechanism))
+      return mechanism;
+  }
+  const Mechanism& m = valueOf(mechanism);
+  if (options.strict && !m.warnings.empty()) {
+    Diagnostic first = m.warnings.front();
+    first.what += " (--strict: warnings are errors)";
+    return first;
+  }
+  return mechanism;
+}
+
+/// MuJoCo reads files (and resolves includes relative to them): text goes through a private temporary file.
+Result<Mechanism> readMjcfText(const std::string& text, const std::string& sourceName) {
+  char path[] = "/tmp/mobility_mjcf_XXXXXX.xml";
+  const int fd = mkstemps(path, 4);
+  if (fd < 0)
+    return makeDiagnostic(sourceName, "mujoco", "", "cannot write a temporary file for MuJoCo");
+  ::close(fd);
+  {
+    std::ofstream out(path);
+    out << text;
+  }
+  Result<Mechanism> mechanism = readMjcf(path);
+  std::remove(path);
+  const std::string file = io_detail::baseName(sourceName);
+  if (isOk(mechanism)) {
+    Mechanism m = valueOf(std::move(mechanism));
+    m.file = file;
+    for (Diagnostic& w : m.warnings)
+      w.file = file;
+    return m;
+  }
+  Diagnostic d = diagnosticOf(mechanism);
+  d.file = file;
+  return d;
+}
+
+}  // namespace
+
+Result<Mechanism> readMechanismFromString(const std::string& text, const std::string& sourceName,
+                                          const ReadOptions& options) {
+  if (rootElement(text) == "mujoco")
+    return finish(readMjcfText(text, sourceName), options);
+  return finish(readUrdf(text, sourceName), options);
+}
+
+Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& options) {
+  std::ifstream stream(path);
+  if (!stream)
+    return makeDiagnostic(path, "", "", "cannot open the file");
+  std::stringstream text;
+  text << stream.rdbuf();
+  const std::string content = text.str();
+  if (rootElement(content) == "mujoco")
+    return finish(readMjcf(path), options);
+  return finish(readUrdf(content, path), options);
+}
+
+}  // namespace mobility_analysis

@@ -1,0 +1,647 @@
+/// The readers of io/: every dialect against its closed form and its hand-converted <loop_joint> twin,
+/// couplings as constraints, warnings that never let a loop go silently, strictness, one-line diagnostics
+/// with hostile names, extreme numbers, deep trees.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "core/TestModels.hpp"
+#include "mobility_analysis/CouplingEquation.hpp"
+
+using namespace mobility_analysis;
+
+namespace {
+
+std::string formatPath(const std::string& name) {
+  return fixturePath("formats/" + name);
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+Mechanism readOrFail(const std::string& path, const ReadOptions& options = {}) {
+  Result<Mechanism> mechanism = readMechanism(path, options);
+  if (!isOk(mechanism)) {
+    ADD_FAILURE() << diagnosticOf(mechanism).toString();
+    return Mechanism{};
+  }
+  return valueOf(std::move(mechanism));
+}
+
+MobilityReport reportOf(const Mechanism& mechanism, AnalysisMode mode, const JointPositions& positions = {}) {
+  AnalysisOptions options;
+  options.mode = mode;
+  options.positions = positions;
+  Result<MobilityAnalysis> analysis = analyzeMechanism(mechanism, options);
+  if (!isOk(analysis)) {
+    ADD_FAILURE() << diagnosticOf(analysis).toString();
+    return MobilityReport{};
+  }
+  return valueOf(std::move(analysis)).report;
+}
+
+/// A one-line message: no newline, no other control character.
+void expectOneLine(const std::string& line) {
+  for (const char c : line) {
+    EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f) << "control character in: " << line;
+  }
+}
+
+std::vector<std::string> warningTexts(const Mechanism& mechanism) {
+  std::vector<std::string> texts;
+  for (const Diagnostic& d : mechanism.warnings)
+    texts.push_back(d.toString());
+  return texts;
+}
+
+bool anyContains(const std::vector<std::string>& texts, const std::string& a, const std::string& b = "") {
+  for (const std::string& t : texts) {
+    if (t.find(a) != std::string::npos && t.find(b) != std::string::npos)
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+// --- every dialect: closed form, and the same numbers as the hand-converted <loop_joint> twin
+// ----------------
+
+struct DialectCase {
+  const char* file;
+  const char* closures;  ///< "" for none
+  AnalysisMode mode;
+  const char* expectedMode;
+  int dof, grubler, redundant;
+  const char* twin;  ///< "" when the closed form alone is the reference
+};
+
+class EveryDialect : public ::testing::TestWithParam<DialectCase> {};
+
+TEST_P(EveryDialect, GivesItsClosedFormDofAndTheNumbersOfItsLoopJointTwin) {
+  const DialectCase& c = GetParam();
+  ReadOptions options;
+  if (*c.closures != '\0')
+    options.closuresFile = formatPath(c.closures);
+  const Mechanism mechanism = readOrFail(formatPath(c.file), options);
+  EXPECT_TRUE(mechanism.warnings.empty()) << mechanism.warnings.front().toString();
+  const MobilityReport report = reportOf(mechanism, c.mode);
+  EXPECT_EQ(report.mode, c.expectedMode);
+  EXPECT_EQ(report.dof, c.dof);
+  EXPECT_EQ(report.grublerKutzbachDof, c.grubler);
+  EXPECT_EQ(report.numRedundant, c.redundant);
+  if (*c.twin != '\0') {
+    const MobilityReport twin = reportOf(readOrFail(formatPath(c.twin)), c.mode);
+    EXPECT_EQ(twin.dof, report.dof);
+    EXPECT_EQ(twin.grublerKutzbachDof, report.grublerKutzbachDof);
+    EXPECT_EQ(twin.numRedundant, report.numRedundant);
+    EXPECT_EQ(twin.numCoordinates, report.numCoordinates);
+    EXPECT_EQ(twin.numConstraints, report.numConstraints);
+  }
+}
+
+// Planar four-bar: DOF 1, Gruebler 3*3 - 2*4 = 1; in space 6*3 - 5*4 = -2 with 3 redundant. Watt six-bar:
+// 3*5 - 2*7 = 1; in space 6*5 - 5*7 = -5, 6 redundant. Five-bar closed by a 6d frame: 3*6 - 2*5 - 3 - 3 = 2.
+INSTANTIATE_TEST_SUITE_P(
+    Formats, EveryDialect,
+    ::testing::Values(
+        DialectCase{"four_bar_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0,
+                    "four_bar_loop_joint.urdf"},
+        DialectCase{"four_bar_urdfplus.urdf", "", AnalysisMode::Spatial, "spatial", 1, -2, 3,
+                    "four_bar_loop_joint.urdf"},
+        DialectCase{"six_bar_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0,
+                    "six_bar_loop_joint.urdf"},
+        DialectCase{"six_bar_urdfplus.urdf", "", AnalysisMode::Spatial, "spatial", 1, -5, 6,
+                    "six_bar_loop_joint.urdf"},
+        DialectCase{"four_bar_drake.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0,
+                    "four_bar_loop_joint.urdf"},
+        DialectCase{"four_bar_drake.urdf", "", AnalysisMode::Spatial, "spatial", 1, -2, 3,
+                    "four_bar_loop_joint.urdf"},
+        DialectCase{"five_bar_gepetto.urdf", "five_bar_6d.yaml", AnalysisMode::Auto, "planar", 2, 2, 0,
+                    "five_bar_loop_joint.urdf"},
+        // Two 6d closures (a Watt six-bar with its closure frames on pins): the six-bar's numbers.
+        DialectCase{"six_bar_gepetto.urdf", "six_bar_6d.yaml", AnalysisMode::Auto, "planar", 1, 1, 0, ""},
+        DialectCase{"six_bar_gepetto.urdf", "six_bar_6d.yaml", AnalysisMode::Spatial, "spatial", 1, -5, 6,
+                    ""},
+        // 3d: a ball at C, so in space: the five-bar's 2 plus closure_B spinning on its pin; 6*6-25-6-3 = 2.
+        DialectCase{"five_bar_gepetto.urdf", "five_bar_3d.yaml", AnalysisMode::Auto, "spatial", 3, 2, 1, ""},
+        // MJCF connect is a ball: 6*3 - 5*3 - 3 = 0, the planar motion makes one equation redundant.
+        DialectCase{"four_bar_mjcf.xml", "", AnalysisMode::Auto, "spatial", 1, 0, 1,
+                    "four_bar_ball_loop_joint.urdf"},
+        // Cassie-like leg: hip-knee four-bar through the Achilles rod (1) + the rod's spin (1); 36 - 34 = 2.
+        DialectCase{"leg_mjcf.xml", "", AnalysisMode::Auto, "spatial", 2, 2, 0, ""},
+        // Couplings: tree minus one.
+        DialectCase{"gripper_mimic.urdf", "", AnalysisMode::Spatial, "spatial", 1, 1, 0, ""},
+        DialectCase{"gripper_revolute_mimic.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, ""},
+        DialectCase{"gears_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, ""}),
+    [](const ::testing::TestParamInfo<DialectCase>& info) {
+      std::string name = std::string(info.param.file) + "_" + info.param.closures + "_" +
+                         (info.param.mode == AnalysisMode::Spatial ? "spatial" : "auto");
+      return std::regex_replace(name, std::regex("[^A-Za-z0-9]"), "_");
+    });
+
+TEST(Readers, WithoutItsLoopsEachModelIsTheOpenTreeItWouldBeAnalysedAsToday) {
+  // The issue's complaint: loops dropped silently give the tree's DOF. Our readers give these only when the
+  // loop really is absent (the loop text removed), and then nothing warns.
+  std::string plus = readText(formatPath("four_bar_urdfplus.urdf"));
+  plus = std::regex_replace(plus, std::regex("<loop [\\s\\S]*</loop>"), "");
+  const Result<Mechanism> tree = readMechanismFromString(plus, "tree.urdf");
+  ASSERT_TRUE(isOk(tree));
+  EXPECT_EQ(reportOf(valueOf(tree), AnalysisMode::Auto).dof, 3);
+  EXPECT_EQ(reportOf(readOrFail(formatPath("five_bar_gepetto.urdf")), AnalysisMode::Auto).dof, 5);
+  std::string gripper = readText(formatPath("gripper_mimic.urdf"));
+  gripper = std::regex_replace(gripper, std::regex("<mimic[^>]*/>"), "");
+  EXPECT_EQ(reportOf(valueOf(readMechanismFromString(gripper, "g.urdf")), AnalysisMode::Spatial).dof, 2);
+}
+
+TEST(Readers, UrdfPlusLoopIsReadLikeALoopJoint) {
+  const Mechanism m = readOrFail(formatPath("four_bar_urdfplus.urdf"));
+  const Joint& loop = m.joints.back();
+  EXPECT_EQ(loop.kind, ConnectionKind::LoopJoint);
+  EXPECT_EQ(loop.type, JointType::Revolute);
+  EXPECT_EQ(m.links[loop.link1].name, "coupler");
+  EXPECT_EQ(m.links[loop.link2].name, "rocker");
+  EXPECT_TRUE(loop.frame1.translation().isApprox(Eigen::Vector3d(0.4, 0.1, 0)));
+  EXPECT_TRUE(loop.frame2.translation().isApprox(Eigen::Vector3d(0, 0.3, 0)));
+  EXPECT_TRUE(loop.axis.isApprox(Eigen::Vector3d::UnitZ()));
+}
+
+TEST(Readers, MjcfBodiesJointsAndEqualitiesMeanWhatMujocoMeans) {
+  const Mechanism m = readOrFail(formatPath("leg_mjcf.xml"));
+  EXPECT_EQ(m.name, "leg_mjcf");
+  EXPECT_EQ(m.links[m.rootLink].name, "world");
+  auto joint = [&](const std::string& name) -> const Joint& { return m.joints[*m.findJoint(name)]; };
+  EXPECT_EQ(joint("fixed_pelvis").type, JointType::Fixed);
+  EXPECT_EQ(joint("rod_ball").type, JointType::Spherical);
+  EXPECT_EQ(joint("knee").type, JointType::Revolute);
+  EXPECT_TRUE(joint("knee").axis.isApprox(Eigen::Vector3d::UnitY()));
+  const Joint& achilles = joint("achilles");
+  EXPECT_EQ(achilles.kind, ConnectionKind::LoopJoint);
+  EXPECT_EQ(achilles.type, JointType::Spherical);
+  // The connect holds at the reference configuration: both ends at the same world point (0.1, 0, 0.9).
+  const LinkPoses poses = computeTreePoses(m, {});
+  EXPECT_TRUE((poses[achilles.link1] * achilles.frame1.translation()).isApprox(Eigen::Vector3d(0.1, 0, 0.9)));
+  EXPECT_TRUE((poses[achilles.link2] * achilles.frame2.translation()).isApprox(Eigen::Vector3d(0.1, 0, 0.9)));
+  const Joint& toe = joint("toe_follows_knee");
+  EXPECT_EQ(toe.kind, ConnectionKind::Coupling);
+  EXPECT_DOUBLE_EQ(toe.multiplier, 0.5);
+  EXPECT_EQ(m.joints[toe.follower].name, "toe_pitch");
+  EXPECT_EQ(m.joints[toe.leader].name, "knee");
+  EXPECT_EQ(m.joints.back().kind, ConnectionKind::Coupling);  // couplings after every loop joint
+}
+
+// --- couplings are constraints
+// -------------------------------------------------------------------------------
+
+TEST(Couplings, HoldTheFollowerAtMultiplierTimesTheLeaderPlusOffset) {
+  // b = -a + 0.1 (gripper_revolute_mimic.urdf): written with both at 0, the assembly closes the coupling.
+  const MobilityReport report =
+      reportOf(readOrFail(formatPath("gripper_revolute_mimic.urdf")), AnalysisMode::Auto);
+  ASSERT_EQ(report.positions.size(), 2u);
+  EXPECT_NEAR(report.positions[1].value, -report.positions[0].value + 0.1, 1e-9);
+  // A gear with a prismatic follower: 0.02 m per rad, offset 0.01 m, in millimetres and metres alike.
+  for (const double unit : {1.0, 0.001}) {
+    std::ostringstream urdf;
+    urdf << "<robot name='rack'><link name='g'/><link name='pinion'/><link name='rack'/>"
+         << "<joint name='turn' type='continuous'><parent link='g'/><child link='pinion'/><axis xyz='0 0 "
+            "1'/></joint>"
+         << "<joint name='slide' type='prismatic'><parent link='g'/><child link='rack'/>"
+         << "<origin xyz='0 " << 0.05 / unit << " 0'/><axis xyz='1 0 0'/>"
+         << "<mimic joint='turn' multiplier='" << 0.02 / unit << "' offset='" << 0.01 / unit
+         << "'/></joint></robot>";
+    const Result<Mechanism> m = readMechanismFromString(urdf.str(), "rack.urdf");
+    ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+    const MobilityReport r = reportOf(valueOf(m), AnalysisMode::Auto);
+    EXPECT_EQ(r.dof, 1);
+    EXPECT_EQ(r.grublerKutzbachDof, 1);
+    ASSERT_EQ(r.positions.size(), 2u);
+    EXPECT_NEAR(r.positions[1].value * unit, 0.02 * r.positions[0].value + 0.01, 1e-9);
+  }
+}
+
+TEST(Couplings, TakePartInTheOrderedRedundancyAfterTheLoopJoints) {
+  // The same gear ratio said twice (a mimic and a URDF+ coupling): the second equation, the <coupling>, is
+  // the redundant one, reported with its own source kind.
+  const char* text = R"(<robot name="twice">
+  <link name="ground"/><link name="a"/><link name="b"/>
+  <joint name="ja" type="continuous"><parent link="ground"/><child link="a"/><axis xyz="0 0 1"/></joint>
+  <joint name="jb" type="continuous"><parent link="ground"/><child link="b"/><origin xyz="0.3 0 0"/>
+    <axis xyz="0 0 1"/><mimic joint="ja" multiplier="-2"/></joint>
+  <coupling name="mesh"><predecessor joint="ja"/><successor joint="jb"/><ratio value="-2"/></coupling>
+</robot>)";
+  const Result<Mechanism> m = readMechanismFromString(text, "twice.urdf");
+  ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+  for (const AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial}) {
+    const MobilityReport r = reportOf(valueOf(m), mode);
+    EXPECT_EQ(r.dof, 1);
+    EXPECT_EQ(r.grublerKutzbachDof, 0);  // each coupling counts as one equation
+    ASSERT_EQ(r.redundantConstraints.size(), 1u);
+    EXPECT_EQ(r.redundantConstraints[0].source, "coupling");
+    EXPECT_EQ(r.redundantConstraints[0].name, "mesh");
+    EXPECT_EQ(r.redundantConstraints[0].kind, "coupling");
+    EXPECT_EQ(r.redundantConstraints[0].index, r.numConstraints - (mode == AnalysisMode::Spatial ? 7 : 4));
+    ASSERT_EQ(r.redundantJoints.size(), 1u);
+    EXPECT_EQ(r.redundantJoints[0].name, "mesh");
+  }
+}
+
+TEST(Couplings, GradientAndHessianMatchCentralDifferences) {
+  for (const char* file : {"gripper_revolute_mimic.urdf", "gripper_mimic.urdf", "gears_urdfplus.urdf"}) {
+    for (const AnalysisMode mode : {AnalysisMode::Planar, AnalysisMode::Spatial}) {
+      const Mechanism m = readOrFail(formatPath(file));
+      JointPositions positions;
+      for (const Joint& j : m.joints) {
+        if (j.kind == ConnectionKind::TreeJoint)
+          positions[j.name] = 0.3 + 0.1 * positions.size();
+      }
+      const LinkPoses poses = computeTreePoses(m, positions);
+      const Result<CoordinateModel> built =
+          buildCoordinateModel(m, poses, mode, computeCharacteristicLength(m, poses));
+      ASSERT_TRUE(isOk(built)) << diagnosticOf(built).toString();
+      const CoordinateModel& model = valueOf(built);
+      ASSERT_EQ(model.couplings.size(), 1u) << file;
+      const Eigen::VectorXd q = computeCoordinates(model, poses);
+      const SparseJacobian J = computeConstraintJacobian(model, q);
+      const int row = model.numConstraints() - model.lambda - 1;  // the coupling: last before the boundary
+      ASSERT_EQ(model.equations[row].kind, EquationKind::Coupling);
+      const double h = 1e-6;
+      Eigen::VectorXd phiPlus, phiMinus;
+      for (int c = 0; c < model.numCoordinates(); ++c) {
+        Eigen::VectorXd qp = q, qm = q;
+        qp(c) += h;
+        qm(c) -= h;
+        computeConstraintResidual(model, qp, phiPlus);
+        computeConstraintResidual(model, qm, phiMinus);
+        EXPECT_NEAR(J.coeff(row, c), (phiPlus(row) - phiMinus(row)) / (2 * h), 1e-7)
+            << file << " column " << c;
+      }
+      // The Hessian against differences of the residual itself (second differences), on its own columns.
+      std::vector<int> columns;
+      Eigen::MatrixXd H;
+      computeCouplingHessian(model.couplings[0], model, q, columns, H);
+      ASSERT_EQ(H.rows(), static_cast<int>(columns.size()));
+      // The same through the form dispatcher every second-order user reads (EquationForms.hpp).
+      const Eigen::MatrixXd full = computeEquationHessian(model, q, row);
+      for (size_t a = 0; a < columns.size(); ++a) {
+        for (size_t b = 0; b < columns.size(); ++b)
+          EXPECT_DOUBLE_EQ(full(columns[a], columns[b]), H(a, b));
+      }
+      EXPECT_NEAR(full.norm(), H.norm(), 1e-12 * (1.0 + H.norm()));
+      const double k = 1e-4;
+      for (size_t a = 0; a < columns.size(); ++a) {
+        for (size_t b = 0; b < columns.size(); ++b) {
+          auto f = [&](double da, double db) {
+            Eigen::VectorXd x = q;
+            x(columns[a]) += da;
+            x(columns[b]) += db;
+            return evaluateCoupling(model.couplings[0], model, x);
+          };
+          const double second = (f(k, k) - f(k, -k) - f(-k, k) + f(-k, -k)) / (4 * k * k);
+          EXPECT_NEAR(H(a, b), second, 1e-4 * (1.0 + std::abs(second))) << file;
+        }
+      }
+    }
+  }
+}
+
+// --- never silent
+// ---------------------------------------------------------------------------------------------
+
+TEST(Warnings, EveryClassFiresAndNamesItsElement) {
+  const char* text = R"(<robot name="w">
+  <link name="ground"/><link name="a"/><link name="b"/><link name="c"/>
+  <joint name="ja" type="revolute"><parent link="ground"/><child link="a"/><axis xyz="0 0 1"/></joint>
+  <joint name="jb" type="revolute"><parent link="a"/><child link="b"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+  <joint name="jc" type="revolute"><parent link="ground"/><child link="c"/><origin xyz="2 0 0"/><axis xyz="0 0 1"/></joint>
+  <loop_joint name="no_axis" type="revolute"><link1 link="b" xyz="1 0 0"/><link1 link="a"/><link2 link="c"/></loop_joint>
+  <loop_joint name="cardan" type="universal"><link1 link="b"/><link2 link="c"/><axis xyz="1 0 0"/><spring k="1"/></loop_joint>
+  <loopjoint name="typo" type="revolute"/>
+  <frobnicate/>
+  <loop_constraint name="old"/>
+  <gazebo/><transmission name="t"/><ros2_control name="r"/><material name="m"/>
+</robot>)";
+  const Result<Mechanism> m = readMechanismFromString(text, "warn.urdf");
+  ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+  const std::vector<std::string> w = warningTexts(valueOf(m));
+  EXPECT_TRUE(anyContains(w, "loopjoint 'typo'", "did you mean <loop_joint>"));
+  EXPECT_TRUE(anyContains(w, "unknown element <frobnicate>"));
+  EXPECT_TRUE(anyContains(w, "loop_constraint 'old'", "<loop>"));
+  EXPECT_TRUE(anyContains(w, "loop_joint 'no_axis'", "more than one <link1>"));
+  EXPECT_TRUE(anyContains(w, "loop_joint 'no_axis'", "axis defaulted to 1 0 0"));
+  EXPECT_TRUE(anyContains(w, "loop_joint 'cardan'", "unknown child <spring>"));
+  EXPECT_TRUE(anyContains(w, "loop_joint 'cardan'", "axis2 defaulted to 0 1 0"));
+  EXPECT_EQ(w.size(), 7u);  // the well-known gazebo, transmission, ros2_control and material are not warnings
+  for (const std::string& line : w) {
+    EXPECT_EQ(line.rfind("warn.urdf: ", 0), 0u) << line;
+    expectOneLine(line);
+  }
+  // URDF+ <loop> and <coupling> children too.
+  const char* plus = R"(<robot name="p"><link name="g"/><link name="a"/><link name="b"/>
+  <joint name="ja" type="continuous"><parent link="g"/><child link="a"/><axis xyz="0 0 1"/></joint>
+  <joint name="jb" type="continuous"><parent link="g"/><child link="b"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+  <loop name="l" type="spherical"><predecessor link="a"/><successor link="b"/><successor link="g"/><damping/></loop>
+  <coupling name="c"><predecessor joint="ja"/><successor joint="jb"/><ratio value="2"/><backlash/></coupling>
+</robot>)";
+  const std::vector<std::string> wp = warningTexts(valueOf(readMechanismFromString(plus, "p.urdf")));
+  EXPECT_TRUE(anyContains(wp, "loop 'l'", "more than one <successor>"));
+  EXPECT_TRUE(anyContains(wp, "loop 'l'", "unknown child <damping>"));
+  EXPECT_TRUE(anyContains(wp, "coupling 'c'", "unknown child <backlash>"));
+  // The closure file and MJCF.
+  const std::string yaml = writeTemp("w.yaml",
+                                     "closed_loop: [['closure_A', 'closure_B']]\ntype: ['6d']\n"
+                                     "joint_type: ['UJOINT_XY']\nsolver: fast\n");
+  ReadOptions options;
+  options.closuresFile = yaml;
+  const std::vector<std::string> wy = warningTexts(readOrFail(formatPath("five_bar_gepetto.urdf"), options));
+  EXPECT_TRUE(anyContains(wy, "w.yaml: yaml 'solver'", "unknown key"));
+  EXPECT_TRUE(anyContains(wy, "closed_loop 'closed_loop_0'", "joint_type 'UJOINT_XY' is not read"));
+  const std::string mjcf = writeTemp("w.xml", R"(<mujoco model="w"><worldbody>
+  <body name="a"><joint name="ja" type="hinge"/><geom size="0.1"/></body>
+  <body name="b" pos="1 0 0"><joint name="jb" type="hinge"/><geom size="0.1"/></body></worldbody>
+  <equality><connect name="off" body1="a" body2="b" anchor="0.5 0 0" active="false"/>
+  <joint name="hold" joint1="ja"/><joint name="cubic" joint1="jb" joint2="ja" polycoef="0 1 0.5 0 0"/></equality>
+</mujoco>)");
+  const std::vector<std::string> wm = warningTexts(readOrFail(mjcf));
+  EXPECT_TRUE(anyContains(wm, "connect 'off'", "inactive"));
+  EXPECT_TRUE(anyContains(wm, "joint 'hold'", "no joint2"));
+  EXPECT_TRUE(anyContains(wm, "joint 'cubic'", "polynomial terms"));
+}
+
+TEST(Warnings, ReachTheReport) {
+  const Result<Mechanism> m = readMechanismFromString(
+      "<robot name='r'><link name='g'/><link name='a'/><joint name='j' type='revolute'><parent link='g'/>"
+      "<child link='a'/><axis xyz='0 0 1'/></joint><loopjoint name='x'/></robot>",
+      "r.urdf");
+  ASSERT_TRUE(isOk(m));
+  const MobilityReport report = reportOf(valueOf(m), AnalysisMode::Auto);
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("did you mean <loop_joint>"), std::string::npos);
+  EXPECT_NE(toJson(report).find("\"warnings\": [\"r.urdf: loopjoint 'x': unknown element"),
+            std::string::npos);
+}
+
+TEST(Warnings, StrictMakesTheFirstAnError) {
+  ReadOptions strict;
+  strict.strict = true;
+  const char* text =
+      "<robot name='r'><link name='g'/><link name='a'/><joint name='j' type='revolute'>"
+      "<parent link='g'/><child link='a'/><axis xyz='0 0 1'/></joint><loopjoint name='x'/></robot>";
+  const Result<Mechanism> m = readMechanismFromString(text, "r.urdf", strict);
+  ASSERT_FALSE(isOk(m));
+  EXPECT_EQ(diagnosticOf(m).elementKind, "loopjoint");
+  EXPECT_NE(diagnosticOf(m).what.find("--strict"), std::string::npos);
+  // A clean file stays clean under strict.
+  EXPECT_TRUE(isOk(readMechanism(formatPath("four_bar_urdfplus.urdf"), strict)));
+}
+
+// --- bad input: one line, every error class, hostile names
+// ------------------------------------------------------
+
+TEST(Diagnostics, EscapeNewlinesAndControlCharacters) {
+  EXPECT_EQ(escapeForLine("gro\nund\t\r\x01\x7f ok"), "gro\\nund\\t\\r\\x01\\x7f ok");
+  const Diagnostic d = makeDiagnostic("a\nb.urdf", "joint", "j\n1", "what\x1b[31m");
+  EXPECT_EQ(d.toString(), "a\\nb.urdf: joint 'j\\n1': what\\x1b[31m");
+}
+
+struct HostileCase {
+  const char* label;
+  std::string text;
+  const char* elementKind;
+};
+
+TEST(Diagnostics, EveryErrorClassWithAHostileNameGivesOneLine) {
+  const std::string h = "evil&#10;name&#9;\x01";  // newline, tab and a raw control character in a name
+  const std::string tree =
+      "<link name='g'/><link name='a'/><link name='b'/>"
+      "<joint name='ja' type='revolute'><parent link='g'/><child link='a'/><axis xyz='0 0 1'/></joint>";
+  const std::string full = tree + "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint>";
+  const std::vector<HostileCase> cases = {
+      {"xml", "<?xml version='1.0'\n?><robot><", "xml"},
+      {"not robot", "<evil\x01/>", "xml"},
+      {"unknown link",
+       "<robot name='r'>" + full + "<loop_joint name='" + h +
+           "' type='fixed'><link1 link='a'/><link2 link='" + h + "'/></loop_joint></robot>",
+       "loop_joint"},
+      {"two parents",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='g'/><child link='a'/></joint></robot>",
+       "joint"},
+      {"bad number",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 " + h + " 0'/></joint></robot>",
+       "joint"},
+      {"non-finite",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 nan 0'/></joint></robot>",
+       "joint"},
+      {"out of range",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='fixed'><parent link='a'/><child link='b'/><origin xyz='1 0 1e308'/></joint></robot>",
+       "joint"},
+      {"zero axis",
+       "<robot name='r'>" + tree + "<joint name='" + h +
+           "' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 0'/></joint></robot>",
+       "joint"},
+      {"duplicate",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint><distance_constraint "
+           "name='jb'><link1 link='a'/><link2 link='b'/></distance_constraint></robot>",
+       "distance_constraint"},
+      {"disconnected", "<robot name='r'><link name='g'/><link name='" + h + "'/></robot>", "link"},
+      {"loop type",
+       "<robot name='r'>" + full + "<loop name='l' type='" + h +
+           "'><predecessor link='a'/><successor link='g'/></loop></robot>",
+       "loop"},
+      {"tree type",
+       "<robot name='r'>" + tree + "<joint name='jb' type='" + h +
+           "'><parent link='a'/><child link='b'/></joint></robot>",
+       "joint"},
+      {"cable",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='fixed'><parent link='a'/><child link='b'/></joint><cable name='" + h +
+           "' length='-1'><link1 link='a'/><link2 link='b'/></cable></robot>",
+       "cable"},
+      {"mimic leader",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 1'/><mimic "
+           "joint='" +
+           h + "'/></joint></robot>",
+       "joint"},
+      {"coupling ratio",
+       "<robot name='r'>" + tree +
+           "<joint name='jb' type='revolute'><parent link='a'/><child link='b'/><axis xyz='0 0 "
+           "1'/></joint><coupling name='" +
+           h + "'><predecessor joint='ja'/><successor joint='jb'/><ratio value='" + h +
+           "'/></coupling></robot>",
+       "coupling"},
+      {"self loop",
+       "<robot name='r'>" + full + "<loop_joint name='" + h +
+           "' type='fixed'><link1 link='a'/><link2 link='a'/></loop_joint></robot>",
+       "loop_joint"},
+  };
+  for (const HostileCase& c : cases) {
+    const Result<Mechanism> m = readMechanismFromString(c.text, "evil\nfile.urdf");
+    ASSERT_FALSE(isOk(m)) << c.label;
+    EXPECT_EQ(diagnosticOf(m).elementKind, c.elementKind) << c.label << ": " << diagnosticOf(m).toString();
+    expectOneLine(diagnosticOf(m).toString());
+  }
+  // The closure file: an unknown frame and a malformed YAML (yaml-cpp's message), each one line.
+  for (const std::string& yaml :
+       {std::string("closed_loop: [['nowhere\\nland', 'closure_B']]\ntype: ['6d']\n"),
+        std::string("closed_loop: [[\n  'a\x01'\ntype: {")}) {
+    ReadOptions options;
+    options.closuresFile = writeTemp("hostile.yaml", yaml);
+    const Result<Mechanism> m = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
+    ASSERT_FALSE(isOk(m)) << yaml;
+    expectOneLine(diagnosticOf(m).toString());
+  }
+  // MuJoCo's own (multi-line) refusal.
+  const Result<Mechanism> mj = readMechanismFromString(
+      "<mujoco model='m'><worldbody><body name='a'><joint type='nonsense\n'/></body></worldbody></mujoco>",
+      "evil.xml");
+  ASSERT_FALSE(isOk(mj));
+  EXPECT_EQ(diagnosticOf(mj).elementKind, "mujoco");
+  expectOneLine(diagnosticOf(mj).toString());
+  // Positions with a hostile joint name.
+  const Mechanism four = readOrFail(formatPath("four_bar_loop_joint.urdf"));
+  const Result<JointPositions> p = makeJointPositions({"j\n1"}, {0.1}, four);
+  ASSERT_FALSE(isOk(p));
+  expectOneLine(diagnosticOf(p).toString());
+}
+
+// --- numbers: representable where they enter, never inf/nan in a written report
+// ---------------------------------
+
+TEST(Numbers, OutOfRangeCoordinatesAndPositionsAreRefusedWhereTheyEnter) {
+  std::string text = readText(formatPath("four_bar_loop_joint.urdf"));
+  const std::string far = std::regex_replace(text, std::regex("xyz=\"0.4 0 0\""), "xyz=\"0.4 0 1e308\"");
+  const Result<Mechanism> m = readMechanismFromString(far, "far.urdf");
+  ASSERT_FALSE(isOk(m));
+  EXPECT_EQ(diagnosticOf(m).elementName, "j3");
+  EXPECT_NE(diagnosticOf(m).what.find("range"), std::string::npos);
+  // 1e12 is the documented edge: accepted; beyond it refused.
+  EXPECT_TRUE(isOk(readMechanismFromString(
+      std::regex_replace(text, std::regex("xyz=\"0.4 0 0\""), "xyz=\"0.4 0 1e12\""), "x.urdf")));
+  const Mechanism four = readOrFail(formatPath("four_bar_loop_joint.urdf"));
+  EXPECT_FALSE(isOk(parseJointPositions("j1=1e155", four)));
+  EXPECT_FALSE(isOk(makeJointPositions({"j1"}, {-1e13}, four)));
+  EXPECT_TRUE(isOk(parseJointPositions("j1=0.5", four)));
+}
+
+TEST(Numbers, TheJsonWriterRefusesInfAndNanAndNeverWritesThem) {
+  MobilityReport report = reportOf(readOrFail(formatPath("four_bar_loop_joint.urdf")), AnalysisMode::Auto);
+  ASSERT_TRUE(isOk(writeJson(report)));
+  MobilityReport withInf = report;
+  withInf.characteristicLength = std::numeric_limits<double>::infinity();
+  MobilityReport withNan = report;
+  withNan.positions[0].value = std::nan("");
+  for (const MobilityReport* bad : {&withInf, &withNan}) {
+    const Result<std::string> json = writeJson(*bad);
+    ASSERT_FALSE(isOk(json));
+    expectOneLine(diagnosticOf(json).toString());
+    EXPECT_FALSE(isOk(writeText(*bad)));
+    // toJson itself writes null, never a token no JSON parser accepts.
+    const std::string raw = toJson(*bad);
+    EXPECT_EQ(raw.find("inf"), std::string::npos);
+    EXPECT_EQ(raw.find("nan"), std::string::npos);
+    EXPECT_NE(raw.find("null"), std::string::npos);
+  }
+  EXPECT_NE(diagnosticOf(writeJson(withInf)).what.find("characteristic_length is inf"), std::string::npos);
+  // Counts that contradict each other are refused too.
+  MobilityReport inconsistent = report;
+  inconsistent.dof += 1;
+  EXPECT_FALSE(isOk(writeJson(inconsistent)));
+  inconsistent = report;
+  inconsistent.numRedundant += 1;
+  EXPECT_FALSE(isOk(writeJson(inconsistent)));
+}
+
+// --- deep trees: read without recursion
+// ------------------------------------------------------------------------------
+
+TEST(DeepTrees, AChainOfTwoHundredThousandLinksLoads) {
+  constexpr int kLinks = 200000;
+  std::string text = "<robot name='chain'><link name='l0'/>";
+  text.reserve(static_cast<size_t>(kLinks) * 160);
+  for (int i = 1; i <= kLinks; ++i) {
+    const std::string n = std::to_string(i), p = std::to_string(i - 1);
+    text += "<link name='l" + n + "'/><joint name='j" + n + "' type='revolute'><parent link='l" + p +
+            "'/><child link='l" + n + "'/><origin xyz='0.1 0 0'/><axis xyz='0 0 1'/></joint>";
+  }
+  text += "</robot>";
+  const Result<Mechanism> m = readMechanismFromString(text, "chain.urdf");
+  ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+  EXPECT_EQ(valueOf(m).links.size(), static_cast<size_t>(kLinks + 1));
+  EXPECT_EQ(valueOf(m).joints.size(), static_cast<size_t>(kLinks));
+  EXPECT_EQ(valueOf(m).rootLink, 0);
+  // A cycle deep in it is still found, iteratively.
+  std::string cyclic = "<robot name='cycle'><link name='l0'/>";
+  for (int i = 1; i <= 30; ++i) {
+    const std::string n = std::to_string(i), p = std::to_string(i == 1 ? 20 : i - 1);
+    cyclic += "<link name='l" + n + "'/><joint name='j" + n + "' type='fixed'><parent link='l" + p +
+              "'/><child link='l" + n + "'/></joint>";
+  }
+  cyclic += "</robot>";
+  const Result<Mechanism> c = readMechanismFromString(cyclic, "cyclic.urdf");
+  ASSERT_FALSE(isOk(c));
+  EXPECT_NE(diagnosticOf(c).toString().find("cycle"), std::string::npos);
+}
+
+TEST(Readers, MjcfWeldHoldsTwoBodiesTogether) {
+  // Two cranks on parallel hinges, welded to each other: nothing moves. In the plane 3*2 - 2*2 - 3 = -1, so
+  // one equation is redundant; in space 6*2 - 5*2 - 6 = -4, four.
+  const std::string path = ::testing::TempDir() + "weld.xml";
+  std::ofstream(path) << R"(<mujoco model="weld"><worldbody>
+  <body name="a"><joint name="ja" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.01"/></body>
+  <body name="b" pos="1 0 0"><joint name="jb" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 -0.5 0 0" size="0.01"/></body>
+  </worldbody><equality><weld name="glue" body1="a" body2="b"/></equality></mujoco>)";
+  const Mechanism m = readOrFail(path);
+  EXPECT_EQ(m.joints[*m.findJoint("glue")].type, JointType::Fixed);
+  const MobilityReport planar = reportOf(m, AnalysisMode::Auto);
+  EXPECT_EQ(planar.mode, "planar");
+  EXPECT_EQ(planar.dof, 0);
+  EXPECT_EQ(planar.grublerKutzbachDof, -1);
+  EXPECT_EQ(planar.numRedundant, 1);
+  const MobilityReport spatial = reportOf(m, AnalysisMode::Spatial);
+  EXPECT_EQ(spatial.dof, 0);
+  EXPECT_EQ(spatial.grublerKutzbachDof, -4);
+  EXPECT_EQ(spatial.numRedundant, 4);
+}
+
+TEST(Readers, ClosureFileNamesTypesAndFramesOfJoints) {
+  // A frame may be a tree joint (its child link's frame); joint_type SPHERICAL makes a 6d pair a ball.
+  const std::string yaml = ::testing::TempDir() + "named.yaml";
+  std::ofstream(yaml) << "closed_loop: [['to_closure_A', 'free_B']]\ntype: ['6d']\njoint_name: ['C']\n"
+                         "joint_type: ['SPHERICAL']\n";
+  ReadOptions options;
+  options.closuresFile = yaml;
+  const Mechanism m = readOrFail(formatPath("five_bar_gepetto.urdf"), options);
+  EXPECT_TRUE(m.warnings.empty());
+  const Joint& c = m.joints[*m.findJoint("C")];
+  EXPECT_EQ(c.kind, ConnectionKind::LoopJoint);
+  EXPECT_EQ(c.type, JointType::Spherical);
+  EXPECT_EQ(m.links[c.link1].name, "closure_A");
+  EXPECT_EQ(m.links[c.link2].name, "closure_B");
+  // Same as the 3d closure file: DOF 3.
+  EXPECT_EQ(reportOf(m, AnalysisMode::Auto).dof, 3);
+  // Sizes that differ are named.
+  std::ofstream(yaml)
+      << "closed_loop: [['closure_A', 'closure_B'], ['closure_A', 'crank_left']]\ntype: ['6d']\n";
+  const Result<Mechanism> bad = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
+  ASSERT_FALSE(isOk(bad));
+  EXPECT_NE(diagnosticOf(bad).what.find("1 types for 2 closed_loop pairs"), std::string::npos);
+}
