@@ -27,4 +27,24 @@ void computeConstraintResidual(const CoordinateModel& model, const Eigen::Ref<co
  */
 SparseJacobian computeConstraintJacobian(const CoordinateModel& model, const Eigen::Ref<const Eigen::VectorXd>& q);
 
+/**
+ * @brief The Hessian of equation @p row, \f$ \partial^2 \Phi_{row} / \partial q^2 \f$ at q (dense,
+ * num_coordinates square; for tests and small models).
+ *
+ * Constant for the quadratic forms (EquationForms.hpp); the triple product's depends on q.
+ */
+Eigen::MatrixXd computeEquationHessian(const CoordinateModel& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                       int row);
+
+/**
+ * @brief The stressed Hessian \f$ \sum_i w_i \, \partial^2 \Phi_i / \partial q^2 \f$ at q, the matrix of the
+ * second-order test (Calladine & Pellegrino 1991): a first-order motion \f$ \delta \f$ extends to second order
+ * only if \f$ \delta^T (\sum_i \omega_i H_i) \delta = 0 \f$ for every self-stress \f$ \omega \f$.
+ * @param[in] weights one weight per equation (dim num_constraints); zero weights cost nothing.
+ * @return Symmetric, num_coordinates square.
+ */
+Eigen::SparseMatrix<double> computeStressedHessian(const CoordinateModel& model,
+                                                   const Eigen::Ref<const Eigen::VectorXd>& q,
+                                                   const Eigen::Ref<const Eigen::VectorXd>& weights);
+
 }  // namespace mobility_analysis

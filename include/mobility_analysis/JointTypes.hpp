@@ -19,6 +19,32 @@ enum class Primitive { CoincidentPoint, ParallelAxis, PointOnAxisLine, FixedTwis
 /// Number of scalar equations of @p primitive in the space of dimension @p dim (3 spatial, 2 planar).
 int equationCount(Primitive primitive, int dim);
 
+/// Which joint elements a primitive's equations read (so phase 1 of the model building adds only those).
+struct PrimitiveElements {
+  bool points = false;    ///< A point of the joint on each body.
+  bool axis1 = false;     ///< The axis on link1 (a line or a plane normal).
+  bool bothAxes = false;  ///< The axis on each body (universal: the second axis on link2).
+};
+
+/**
+ * @brief One row of the primitive table: its equation counts and the elements it reads. The equations
+ * themselves are written by the primitive's writer in src/core/coordinates/JointEquations.cpp, and their
+ * algebra (value, gradient, Hessian) lives in the form types of coordinates/EquationForms.hpp.
+ */
+struct PrimitiveSpec {
+  Primitive primitive;
+  const char* name;      ///< "coincident_point", … (the EquationKind it writes).
+  int spatialEquations;  ///< lambda = 6.
+  int planarEquations;   ///< lambda = 3.
+  PrimitiveElements elements;
+};
+
+/// @return The table row of @p primitive.
+const PrimitiveSpec& getPrimitiveSpec(Primitive primitive);
+
+/// @return The elements @p primitive reads.
+inline PrimitiveElements primitiveElements(Primitive primitive) { return getPrimitiveSpec(primitive).elements; }
+
 /// How a joint acts when the mechanism is analysed in the plane.
 enum class PlanarForm {
   Pin,     ///< Turns about the plane normal: {CoincidentPoint}, freedom 1.

@@ -30,20 +30,38 @@ const JointTypeSpec kJointTypes[] = {
     {JointType::Floating, 6, {}, false},
 };
 
+// One row per primitive: equation counts (spatial, planar) and the joint elements it reads
+// {points, axis1, bothAxes}.
+const PrimitiveSpec kPrimitives[] = {
+    // p_A - p_B = 0.
+    {Primitive::CoincidentPoint, "coincident_point", 3, 2, {true, false, false}},
+    // u_A x u_B = 0 on the non-degenerate components.
+    {Primitive::ParallelAxis, "parallel_axis", 2, 1, {false, false, true}},
+    // u_A x (p_B - p_A) = 0 on the non-degenerate components.
+    {Primitive::PointOnAxisLine, "point_on_axis_line", 2, 1, {true, true, false}},
+    // a.b, (a x b)_k or (a x b).c constant for directions of the two bodies' bases that see the turn.
+    {Primitive::FixedTwist, "fixed_twist", 1, 1, {false, false, false}},
+    // u_A.v_B = cos(gamma).
+    {Primitive::AxisAngle, "axis_angle", 1, 0, {false, false, true}},
+    // (p_B - p_A).u_A = 0.
+    {Primitive::PointInPlane, "point_in_plane", 1, 0, {true, true, false}},
+    // |p_B - p_A|^2 = L^2.
+    {Primitive::Distance, "distance_constraint", 1, 1, {true, false, false}},
+};
+
 }  // namespace
 
-int equationCount(Primitive primitive, int dim) {
-  const bool spatial = dim == 3;
-  switch (primitive) {
-    case Primitive::CoincidentPoint: return spatial ? 3 : 2;
-    case Primitive::ParallelAxis: return spatial ? 2 : 1;
-    case Primitive::PointOnAxisLine: return spatial ? 2 : 1;
-    case Primitive::FixedTwist: return 1;
-    case Primitive::AxisAngle: return spatial ? 1 : 0;
-    case Primitive::PointInPlane: return spatial ? 1 : 0;
-    case Primitive::Distance: return 1;
+const PrimitiveSpec& getPrimitiveSpec(Primitive primitive) {
+  for (const PrimitiveSpec& spec : kPrimitives) {
+    if (spec.primitive == primitive)
+      return spec;
   }
-  return 0;
+  return kPrimitives[0];  // unreachable: every enumerator has a row
+}
+
+int equationCount(Primitive primitive, int dim) {
+  const PrimitiveSpec& spec = getPrimitiveSpec(primitive);
+  return dim == 3 ? spec.spatialEquations : spec.planarEquations;
 }
 
 const JointTypeSpec& getJointTypeSpec(JointType type) {

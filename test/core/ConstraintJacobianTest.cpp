@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "EigenTestHelpers.hpp"
+#include "mobility_analysis/coordinates/EquationForms.hpp"
 #include "core/TestModels.hpp"
 
 using namespace mobility_analysis;
@@ -121,4 +122,82 @@ TEST(ConstraintJacobian, EachEquationWritesOnlyItsOwnFewColumns) {
     EXPECT_LE(J.row(r).nonZeros(), 4 * model.dim) << describeEquation(model, r);
     EXPECT_GT(J.row(r).nonZeros(), 0) << describeEquation(model, r);
   }
+}
+
+namespace {
+
+/// Each equation's Hessian against central differences of its Jacobian row at a random pose, per form; the
+/// quadratic forms' Hessians must not move with q, and the stressed Hessian is the weighted sum.
+void expectHessiansMatchFiniteDifferences(const CoordinateModel& model, unsigned seed,
+                                          std::set<EquationForm>& formsSeen) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> uniform(-0.3, 0.3);
+  Eigen::VectorXd q = model.q0, q2 = model.q0;
+  for (int i = 0; i < q.size(); ++i) {
+    q(i) += uniform(random);
+    q2(i) += uniform(random);
+  }
+  const double h = 1e-5;
+  std::vector<Eigen::MatrixXd> numeric(model.numConstraints(),
+                                       Eigen::MatrixXd(model.numCoordinates(), model.numCoordinates()));
+  for (int j = 0; j < q.size(); ++j) {
+    Eigen::VectorXd qp = q, qm = q;
+    qp(j) += h;
+    qm(j) -= h;
+    const Eigen::MatrixXd difference =
+        (Eigen::MatrixXd(computeConstraintJacobian(model, qp)) - Eigen::MatrixXd(computeConstraintJacobian(model, qm))) /
+        (2 * h);
+    for (int i = 0; i < model.numConstraints(); ++i)
+      numeric[i].col(j) = difference.row(i).transpose();
+  }
+  Eigen::VectorXd weights(model.numConstraints());
+  Eigen::MatrixXd weightedSum = Eigen::MatrixXd::Zero(model.numCoordinates(), model.numCoordinates());
+  for (int i = 0; i < model.numConstraints(); ++i) {
+    const ConstraintEquation& eq = model.equations[i];
+    formsSeen.insert(eq.form);
+    const Eigen::MatrixXd analytic = computeEquationHessian(model, q, i);
+    EXPECT_TRUE(matricesNear(numeric[i], analytic, 1e-7)) << describeEquation(model, i);
+    EXPECT_TRUE(matricesNear(analytic, analytic.transpose(), 0.0)) << "not symmetric: " << describeEquation(model, i);
+    if (hasConstantHessian(eq.form)) {
+      EXPECT_TRUE(matricesNear(computeEquationHessian(model, q2, i), analytic, 1e-14)) << describeEquation(model, i);
+    }
+    weights(i) = uniform(random);
+    weightedSum += weights(i) * analytic;
+  }
+  EXPECT_TRUE(matricesNear(Eigen::MatrixXd(computeStressedHessian(model, q, weights)), weightedSum, 1e-12));
+  // Second-order Taylor expansion: exact (up to rounding) for the quadratic forms, O(|d|^3) for the triple.
+  Eigen::VectorXd delta(q.size());
+  for (int i = 0; i < delta.size(); ++i)
+    delta(i) = 1e-3 * uniform(random);
+  Eigen::VectorXd phi, phiStep;
+  computeConstraintResidual(model, q, phi);
+  computeConstraintResidual(model, q + delta, phiStep);
+  const Eigen::VectorXd linear = computeConstraintJacobian(model, q) * delta;
+  for (int i = 0; i < model.numConstraints(); ++i) {
+    const double quadratic = 0.5 * delta.dot(computeEquationHessian(model, q, i) * delta);
+    EXPECT_NEAR(phiStep(i), phi(i) + linear(i) + quadratic, hasConstantHessian(model.equations[i].form) ? 1e-13 : 1e-8)
+        << describeEquation(model, i);
+  }
+}
+
+}  // namespace
+
+TEST(ConstraintJacobian, HessiansMatchFiniteDifferencesForEveryForm) {
+  std::set<EquationForm> forms;
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    expectHessiansMatchFiniteDifferences(buildFromText(allJointKindsUrdf(), AnalysisMode::Spatial), seed, forms);
+    expectHessiansMatchFiniteDifferences(buildFromText(planarJointKindsUrdf(), AnalysisMode::Planar), seed, forms);
+  }
+  const Mechanism sliders = loadOrFail(urdfPath("three_sliders.urdf"));
+  const LinkPoses poses = computeTreePoses(sliders, {});
+  const Result<CoordinateModel> spatialSliders = buildCoordinateModel(
+      sliders, poses, AnalysisMode::Spatial, computeCharacteristicLength(sliders, poses));
+  ASSERT_TRUE(isOk(spatialSliders));
+  expectHessiansMatchFiniteDifferences(valueOf(spatialSliders), 7, forms);
+  for (EquationForm form : {EquationForm::Dot, EquationForm::Cross, EquationForm::Component,
+                            EquationForm::Combination, EquationForm::Triple}) {
+    EXPECT_TRUE(forms.count(form)) << "no equation of form " << static_cast<int>(form);
+  }
+  EXPECT_FALSE(hasConstantHessian(EquationForm::Triple));
+  EXPECT_TRUE(hasConstantHessian(EquationForm::Combination));
 }

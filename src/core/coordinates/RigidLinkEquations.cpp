@@ -1,0 +1,78 @@
+#include <Eigen/Dense>
+
+#include "mobility_analysis/coordinates/ModelBuilder.hpp"
+
+namespace mobility_analysis {
+
+void addRigidLinkEquations(ModelBuilder& builder) {
+  CoordinateModel& model = builder.model;
+  const bool planar = builder.planar();
+  const int dim = model.dim;
+  // Links in document order: the basis dot products (d_i.d_j fixed), then every other element as a linear
+  // combination of the basis (García de Jalón & Bayo, ch. 3), so each body keeps exactly lambda freedoms.
+  for (size_t b = 0; b < builder.mechanism.links.size(); ++b) {
+    const BodyBasis& basis = builder.bases[b];
+    std::vector<Direction> dirs = {basis.d1};
+    if (!planar)
+      dirs.push_back(basis.d2);
+    for (size_t i = 0; i < dirs.size(); ++i) {
+      for (size_t j = i; j < dirs.size(); ++j) {
+        ConstraintEquation eq;
+        eq.source = EquationSource::Link;
+        eq.element = static_cast<int>(b);
+        eq.form = EquationForm::Dot;
+        eq.a = dirs[i];
+        eq.b = dirs[j];
+        eq.value = builder.directionValue(dirs[i]).dot(builder.directionValue(dirs[j]));
+        if (i == j && dirs[i].tail < 0) {
+          eq.kind = EquationKind::UnitNorm;
+          eq.value = 1.0;
+        } else if (i == j) {
+          eq.kind = EquationKind::LinkDistance;
+        } else {
+          eq.kind = EquationKind::LinkDotProduct;
+        }
+        model.equations.push_back(eq);
+      }
+    }
+    const Eigen::Vector3d d1 = builder.directionValue(basis.d1);
+    Eigen::Matrix3d frame;
+    if (planar) {
+      frame.col(0) = d1;
+      frame.col(1) = Eigen::Vector3d(-d1.y(), d1.x(), 0.0);
+      frame.col(2) = Eigen::Vector3d::UnitZ();
+    } else {
+      const Eigen::Vector3d d2 = builder.directionValue(basis.d2);
+      frame.col(0) = d1;
+      frame.col(1) = d2;
+      frame.col(2) = d1.cross(d2);
+    }
+    const Eigen::PartialPivLU<Eigen::Matrix3d> lu(frame);
+    for (int e : model.bodyElements[b]) {
+      if (e == basis.p0 || e == basis.d1.head || (!planar && e == basis.d2.head))
+        continue;
+      const bool isPoint = model.elements[e].isPoint;
+      const Eigen::Vector3d rhs =
+          isPoint ? (builder.coordinates(e) - builder.coordinates(basis.p0)).eval() : builder.coordinates(e);
+      const Eigen::Vector3d coefficients = lu.solve(rhs);
+      for (int k = 0; k < dim; ++k) {
+        ConstraintEquation eq;
+        eq.source = EquationSource::Link;
+        eq.element = static_cast<int>(b);
+        eq.kind = EquationKind::LinearCombination;
+        eq.form = EquationForm::Combination;
+        eq.component = k;
+        eq.target = e;
+        eq.origin = isPoint ? basis.p0 : -1;
+        eq.d1 = basis.d1;
+        eq.d2 = basis.d2;
+        eq.coefficients = coefficients;
+        if (planar)
+          eq.coefficients.z() = 0.0;
+        model.equations.push_back(eq);
+      }
+    }
+  }
+}
+
+}  // namespace mobility_analysis
