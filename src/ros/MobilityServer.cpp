@@ -80,7 +80,7 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
                  "' is not set (or not a string); call ~load_robot to load a model";
     ROS_ERROR("%s", loadError_.c_str());
   } else {
-    Result<StatePtr> state = loadDescription(description, "robot_description", mode_);
+    Result<std::shared_ptr<State>> state = loadDescription(description, "robot_description", mode_);
     if (isOk(state)) {
       const MobilityReport& r = valueOf(state)->analysis.report;
       ROS_INFO("Serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations", r.robot.c_str(),
@@ -104,6 +104,17 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
       "input_joint_states", 1, [this](const sensor_msgs::JointStateConstPtr& m) { onJointStates(m); },
       ros::VoidPtr(), &motionQueue_);
   jointStateSubscriber_ = nodeHandle_.subscribe(options);
+  if (publishRate_ > 0.0) {
+    // robot_state_publisher turns each joint_states into /tf, which is not latched: repeat the state (as
+    // joint_state_publisher does) so a late rviz or tf listener sees it.
+    ros::NodeHandle motionHandle(nodeHandle_);
+    motionHandle.setCallbackQueue(&motionQueue_);
+    republishTimer_ = motionHandle.createWallTimer(
+        ros::WallDuration(1.0 / publishRate_), [this](const ros::WallTimerEvent&) {
+          if (const StatePtr state = current())
+            jointStatePublisher_.publish(toJointState(state->analysis.report, ros::Time::now()));
+        });
+  }
   motionSpinner_ = std::make_unique<ros::AsyncSpinner>(1, &motionQueue_);
   motionSpinner_->start();
   if (animate_)
@@ -112,6 +123,7 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
 
 MobilityServer::~MobilityServer() {
   stopping_ = true;
+  republishTimer_.stop();
   if (animation_.joinable())
     animation_.join();
   if (motionSpinner_)
@@ -153,7 +165,8 @@ bool MobilityServer::readParameters() {
     return true;
   };
   if (!readNumber("rank_tolerance", rankTolerance_, 0.0, 1.0, "a relative rank threshold, default 1e-8") ||
-      !readNumber("load_timeout", loadTimeout_, 0.0, 1e9, "seconds a ~load_robot may take, default 600")) {
+      !readNumber("load_timeout", loadTimeout_, 0.0, 1e9, "seconds a ~load_robot may take, default 600") ||
+      !readNumber("publish_rate", publishRate_, -1e-9, 1e4, "joint_states repeated per second, default 10")) {
     return false;
   }
 
@@ -199,9 +212,9 @@ AnalysisOptions MobilityServer::makeOptions(AnalysisMode mode, const JointPositi
   return options;
 }
 
-Result<MobilityServer::StatePtr> MobilityServer::loadDescription(const std::string& urdfText,
-                                                                 const std::string& source,
-                                                                 AnalysisMode mode) const {
+Result<std::shared_ptr<MobilityServer::State>> MobilityServer::loadDescription(const std::string& urdfText,
+                                                                               const std::string& source,
+                                                                               AnalysisMode mode) const {
   const auto start = std::chrono::steady_clock::now();
   try {
     Result<Mechanism> mechanism = loadMechanismFromString(urdfText, source);
@@ -226,7 +239,7 @@ Result<MobilityServer::StatePtr> MobilityServer::loadDescription(const std::stri
     if (!isOk(analysis))
       return diagnosticOf(analysis);
     state->analysis = valueOf(std::move(analysis));
-    return StatePtr(std::move(state));
+    return state;
   } catch (const AnalysisTimeout& e) {
     return makeDiagnostic(source, "load_robot", "", e.what());
   } catch (const std::bad_alloc&) {
@@ -329,7 +342,8 @@ bool MobilityServer::getRedundancy(GetRedundancy::Request& request, GetRedundanc
 bool MobilityServer::loadRobot(LoadRobot::Request& request, LoadRobot::Response& response) {
   return guarded("load_robot", response, [&] {
     std::lock_guard<std::mutex> loading(loadMutex_);
-    const Result<StatePtr> loaded = [&]() -> Result<StatePtr> {
+    const auto start = std::chrono::steady_clock::now();
+    Result<std::shared_ptr<State>> loaded = [&]() -> Result<std::shared_ptr<State>> {
       if (request.mode.empty())
         return loadDescription(request.urdf, "load_robot", mode_);
       const Result<AnalysisMode> mode = parseAnalysisMode(request.mode);
@@ -346,7 +360,8 @@ bool MobilityServer::loadRobot(LoadRobot::Request& request, LoadRobot::Response&
       ROS_WARN("load_robot: %s (the previous model stays loaded)", response.message.c_str());
       return;
     }
-    auto state = std::make_shared<State>(*valueOf(loaded));
+    const double analysed = secondsSince(start);
+    std::shared_ptr<State> state = valueOf(std::move(loaded));
     {
       // Swap in: the state loop finishes the step it is in (its result, of the old model, is then dropped).
       std::lock_guard<std::mutex> motion(motionMutex_);
@@ -362,8 +377,11 @@ bool MobilityServer::loadRobot(LoadRobot::Request& request, LoadRobot::Response&
     }
     toResponse(state->analysis.report, response);
     const MobilityReport& r = state->analysis.report;
-    ROS_INFO("load_robot: now serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations", r.robot.c_str(),
-             r.mode.c_str(), r.dof, r.grublerKutzbachDof, r.numRedundant);
+    ROS_INFO(
+        "load_robot: now serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations (read and analysed in "
+        "%.3f s, served in %.3f s)",
+        r.robot.c_str(), r.mode.c_str(), r.dof, r.grublerKutzbachDof, r.numRedundant, analysed,
+        secondsSince(start));
   });
 }
 

@@ -415,6 +415,26 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   };
 
   const std::vector<std::vector<Eigen::Vector3d>> allPoints = linkPoints(mechanism, poses, scale);
+  // Labels are pushed away from the model's centre (and joint labels off the joint's axis), so that they
+  // stand beside the geometry rather than inside it, and neighbouring labels part.
+  Eigen::Vector3d modelCentre = Eigen::Vector3d::Zero();
+  size_t numPoints = 0;
+  for (const auto& points : allPoints) {
+    for (const Eigen::Vector3d& p : points)
+      modelCentre += p;
+    numPoints += points.size();
+  }
+  if (numPoints > 0)
+    modelCentre /= static_cast<double>(numPoints);
+  auto outward = [&](const Eigen::Vector3d& at, const Eigen::Vector3d& axis) {
+    Eigen::Vector3d d = at - modelCentre;
+    if (axis.norm() > 0.0)
+      d -= d.dot(axis.normalized()) * axis.normalized();
+    if (d.norm() < kSamePoint * scale)
+      d = axis.norm() > 0.0 ? axis.unitOrthogonal() : Eigen::Vector3d::UnitZ();
+    return Eigen::Vector3d(d.normalized());
+  };
+  auto halfWidth = [&](const std::string& text) { return 0.3 * kTextHeight * scale * text.size(); };
   for (int l = 0; l < numLinks; ++l) {
     const std_msgs::ColorRGBA color = toColor(classOf(report.links, l), true);
     const std::vector<Eigen::Vector3d>& points = allPoints[l];
@@ -451,7 +471,10 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
       }
       array.markers.push_back(m);
     }
-    label(l, mechanism.links[l].name, centroid + Eigen::Vector3d(0, 0, 0.6 * kTextHeight * scale), color);
+    label(l, mechanism.links[l].name,
+          centroid +
+              (kJointDiameter * scale + kTextHeight * scale) * outward(centroid, Eigen::Vector3d::Zero()),
+          color);
   }
 
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
@@ -507,7 +530,13 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
     array.markers.push_back(m);
     lower = lower.cwiseMin(p2);
     upper = upper.cwiseMax(p2);
-    label(numLinks + id, joint.name, p2 + Eigen::Vector3d(0, 0, 1.2 * kSphereDiameter * scale), color);
+    // Beside the joint, off its axis (a label on a hinge's axis hides in its cylinder).
+    const bool hasAxis = joint.type == JointType::Revolute || joint.type == JointType::Continuous ||
+                         joint.type == JointType::Cylindrical || joint.type == JointType::Prismatic;
+    label(numLinks + id, joint.name,
+          p2 + (kSphereDiameter * scale + halfWidth(joint.name)) *
+                   outward(p2, hasAxis ? axis : Eigen::Vector3d::Zero()),
+          color);
   }
   array.markers.insert(array.markers.end(), labels.begin(), labels.end());
 
@@ -519,9 +548,14 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
                   report.robot.c_str(), report.dof, report.grublerKutzbachDof, report.numRedundant);
     Marker title =
         makeMarker(frame, stamp, kTitleNamespace, 0, Marker::TEXT_VIEW_FACING, makeColor(1.0f, 1.0f, 1.0f));
+    // Above the model: over its top, or beyond its +y edge when it lies flat (mobility_viewer then looks down
+    // with +y up the screen).
+    const Eigen::Vector3d extent = upper - lower;
+    const Eigen::Vector3d middle = 0.5 * (lower + upper);
+    const bool flat = extent.z() < 0.2 * std::max(extent.x(), extent.y());
     title.pose.position =
-        toPoint(Eigen::Vector3d(0.5 * (lower.x() + upper.x()), 0.5 * (lower.y() + upper.y()),
-                                upper.z() + 2.5 * kTitleHeight * scale));
+        toPoint(flat ? Eigen::Vector3d(middle.x(), upper.y() + 2.5 * kTitleHeight * scale, upper.z())
+                     : Eigen::Vector3d(middle.x(), middle.y(), upper.z() + 2.5 * kTitleHeight * scale));
     title.scale.x = title.scale.y = title.scale.z = kTitleHeight * scale;
     title.text = text;
     array.markers.push_back(title);

@@ -31,7 +31,9 @@ namespace mobility_analysis {
  * `~publish_link_tf` (default true: every link's frame from the root on /tf_static; false when a
  * robot_state_publisher beside the node turns `joint_states` into tf: then only the links hung by a floating
  * joint, which it does not publish), `~load_timeout` (s, default 600: a longer ~load_robot is refused),
- * `~animate` (default false: sweep the first driveable joint back and forth while no input arrives).
+ * `~animate` (default false: sweep the first driveable joint back and forth while no input arrives),
+ * `~publish_rate` (default 10 Hz: the current joint_states is repeated so robot_state_publisher keeps tf
+ * fresh; 0 publishes only on change).
  *
  * Threads: services run on the spinner threads of the global queue; `input_joint_states` and the animation on
  * a queue of their own. Every answer is read from an immutable State behind a shared pointer, swapped under a
@@ -68,8 +70,8 @@ class MobilityServer {
   /// The state in force (null when nothing is served).
   StatePtr current() const;
   /// Loads and analyses the URDF text within ~load_timeout; nothing is changed here.
-  Result<StatePtr> loadDescription(const std::string& urdfText, const std::string& source,
-                                   AnalysisMode mode) const;
+  Result<std::shared_ptr<State>> loadDescription(const std::string& urdfText, const std::string& source,
+                                                 AnalysisMode mode) const;
   /// Analysis options for this node (tolerance, progress logging, deadline).
   AnalysisOptions makeOptions(AnalysisMode mode, const JointPositions& positions, double timeout) const;
   /**
@@ -98,6 +100,7 @@ class MobilityServer {
   AnalysisMode mode_ = AnalysisMode::Auto;
   double rankTolerance_ = -1.0;
   double loadTimeout_ = 600.0;
+  double publishRate_ = 10.0;
   bool publishLinkTf_ = true;
   bool animate_ = false;
   std::string fixedFrame_ = "mobility_world";
@@ -122,6 +125,7 @@ class MobilityServer {
   ros::CallbackQueue motionQueue_;
   std::unique_ptr<ros::AsyncSpinner> motionSpinner_;
   ros::Subscriber jointStateSubscriber_;
+  ros::WallTimer republishTimer_;
   std::atomic<bool> stopping_{false};
   std::thread animation_;
 };
