@@ -170,6 +170,12 @@ bool MobilityServer::readParameters() {
     return false;
   }
 
+  if (privateNodeHandle_.hasParam("closures")) {
+    // TODO(readers): read the closure file through readMechanismFromString once the readers' front door is in.
+    ROS_FATAL("Parameter '%s' is not supported by this build (the closure-file reader is not in it)",
+              privateNodeHandle_.resolveName("closures").c_str());
+    return false;
+  }
   if (privateNodeHandle_.hasParam("fixed_frame") &&
       !privateNodeHandle_.getParam("fixed_frame", fixedFrame_)) {
     ROS_FATAL("Parameter '%s' must be a string (a tf frame id, or empty)",

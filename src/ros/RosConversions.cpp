@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <map>
 
 #include "mobility_analysis/ElementClassification.h"
 #include "mobility_analysis/UrdfLoader.hpp"
@@ -538,6 +540,43 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
                    outward(p2, hasAxis ? axis : Eigen::Vector3d::Zero()),
           color);
   }
+  // Labels that fall on one another (a door and its frame share their joint points) part downwards: the first
+  // keeps its place, the next moves one line down until its cell is free.
+  const Eigen::Vector3d extent = upper - lower;
+  const bool flat = extent.z() < 0.2 * std::max(extent.x(), extent.y());  // Viewed from above, +y up.
+  const Eigen::Vector3d up = flat ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+  const double line = kTextHeight * scale;
+  std::map<std::array<long long, 3>, std::vector<Eigen::Vector3d>> taken;  // Label positions by grid cell.
+  auto cellOf = [&](const Eigen::Vector3d& at) {
+    return std::array<long long, 3>{std::llround(at.x() / line), std::llround(at.y() / line),
+                                    std::llround(at.z() / line)};
+  };
+  auto isFree = [&](const Eigen::Vector3d& at) {
+    const std::array<long long, 3> c = cellOf(at);
+    for (long long dx = -1; dx <= 1; ++dx) {
+      for (long long dy = -1; dy <= 1; ++dy) {
+        for (long long dz = -1; dz <= 1; ++dz) {
+          const auto found = taken.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (found == taken.end())
+            continue;
+          for (const Eigen::Vector3d& other : found->second) {
+            if ((other - at).norm() < 0.8 * line)
+              return false;
+          }
+        }
+      }
+    }
+    return true;
+  };
+  double top = -std::numeric_limits<double>::max();
+  for (Marker& m : labels) {
+    Eigen::Vector3d at(m.pose.position.x, m.pose.position.y, m.pose.position.z);
+    for (int i = 0; i < 1000 && !isFree(at); ++i)
+      at -= 1.2 * line * up;
+    taken[cellOf(at)].push_back(at);
+    m.pose.position = toPoint(at);
+    top = std::max(top, at.dot(up));
+  }
   array.markers.insert(array.markers.end(), labels.begin(), labels.end());
 
   if (!mechanism.links.empty()) {
@@ -548,14 +587,14 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
                   report.robot.c_str(), report.dof, report.grublerKutzbachDof, report.numRedundant);
     Marker title =
         makeMarker(frame, stamp, kTitleNamespace, 0, Marker::TEXT_VIEW_FACING, makeColor(1.0f, 1.0f, 1.0f));
-    // Above the model: over its top, or beyond its +y edge when it lies flat (mobility_viewer then looks down
-    // with +y up the screen).
-    const Eigen::Vector3d extent = upper - lower;
-    const Eigen::Vector3d middle = 0.5 * (lower + upper);
-    const bool flat = extent.z() < 0.2 * std::max(extent.x(), extent.y());
-    title.pose.position =
-        toPoint(flat ? Eigen::Vector3d(middle.x(), upper.y() + 2.5 * kTitleHeight * scale, upper.z())
-                     : Eigen::Vector3d(middle.x(), middle.y(), upper.z() + 2.5 * kTitleHeight * scale));
+    // Above the model and its labels: over its top, or beyond its +y edge when it lies flat (mobility_viewer
+    // then looks down with +y up the screen).
+    Eigen::Vector3d at = 0.5 * (lower + upper);
+    if (flat)
+      at.z() = upper.z();
+    const double height = std::max(top, upper.dot(up)) + 1.5 * kTitleHeight * scale;
+    at += (height - at.dot(up)) * up;
+    title.pose.position = toPoint(at);
     title.scale.x = title.scale.y = title.scale.z = kTitleHeight * scale;
     title.text = text;
     array.markers.push_back(title);

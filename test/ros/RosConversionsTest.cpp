@@ -70,6 +70,22 @@ void checkMarkers(const visualization_msgs::MarkerArray& array, const Mechanism&
       EXPECT_EQ(m.points.size() % 2, 0u);
     }
   }
+  // No two labels on one another: at least half a text height apart (a door and its frame share their
+  // points).
+  std::vector<Eigen::Vector3d> labelAt;
+  double textHeight = 0.0;
+  for (const Marker& m : array.markers) {
+    if (m.ns != kLabelsNamespace)
+      continue;
+    labelAt.emplace_back(m.pose.position.x, m.pose.position.y, m.pose.position.z);
+    textHeight = m.scale.z;
+  }
+  for (size_t a = 0; a < labelAt.size(); ++a) {
+    for (size_t b = a + 1; b < labelAt.size(); ++b) {
+      EXPECT_GT((labelAt[a] - labelAt[b]).norm(), 0.5 * textHeight)
+          << "labels " << a << " and " << b << " overlap";
+    }
+  }
   const int numLinks = static_cast<int>(mechanism.links.size());
   const int numJoints = static_cast<int>(mechanism.joints.size());
   EXPECT_EQ(perNamespace[kLinksNamespace], numLinks);
