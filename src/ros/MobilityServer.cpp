@@ -433,6 +433,7 @@ bool MobilityServer::move(Move::Request& request, Move::Response& response) {
     for (int k = 0; k < request.steps && ros::ok(); ++k) {
       if (k > 0 && request.duration > 0.0)
         pause.sleep();
+      lastInputTime_ = ros::WallTime::now().toSec();  // A sweep is input: ~animate waits for it.
       const double value = origin + request.start + (request.end - request.start) * k / (request.steps - 1);
       std::lock_guard<std::mutex> motion(motionMutex_);
       const StatePtr from = current();

@@ -546,12 +546,22 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   const bool flat = extent.z() < 0.2 * std::max(extent.x(), extent.y());  // Viewed from above, +y up.
   const Eigen::Vector3d up = flat ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
   const double line = kTextHeight * scale;
-  std::map<std::array<long long, 3>, std::vector<Eigen::Vector3d>> taken;  // Label positions by grid cell.
-  auto cellOf = [&](const Eigen::Vector3d& at) {
-    return std::array<long long, 3>{std::llround(at.x() / line), std::llround(at.y() / line),
-                                    std::llround(at.z() / line)};
+  // Two labels overlap when they are less than a line apart along `up` and their texts (about 0.6 text
+  // heights per character, centred) meet across it. Cells of the widest text keep the search local.
+  size_t longest = 1;
+  for (const Marker& m : labels)
+    longest = std::max(longest, m.text.size());
+  const double cellSize = std::max(line, 2.0 * halfWidth(std::string(longest, 'x')));
+  struct Placed {
+    Eigen::Vector3d at;
+    double halfWidth;
   };
-  auto isFree = [&](const Eigen::Vector3d& at) {
+  std::map<std::array<long long, 3>, std::vector<Placed>> taken;  // Placed labels by grid cell.
+  auto cellOf = [&](const Eigen::Vector3d& at) {
+    return std::array<long long, 3>{std::llround(at.x() / cellSize), std::llround(at.y() / cellSize),
+                                    std::llround(at.z() / cellSize)};
+  };
+  auto isFree = [&](const Eigen::Vector3d& at, double width) {
     const std::array<long long, 3> c = cellOf(at);
     for (long long dx = -1; dx <= 1; ++dx) {
       for (long long dy = -1; dy <= 1; ++dy) {
@@ -559,8 +569,10 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
           const auto found = taken.find({c[0] + dx, c[1] + dy, c[2] + dz});
           if (found == taken.end())
             continue;
-          for (const Eigen::Vector3d& other : found->second) {
-            if ((other - at).norm() < 0.8 * line)
+          for (const Placed& other : found->second) {
+            const Eigen::Vector3d d = other.at - at;
+            const double along = d.dot(up);
+            if (std::abs(along) < 0.9 * line && (d - along * up).norm() < width + other.halfWidth)
               return false;
           }
         }
@@ -571,9 +583,10 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   double top = -std::numeric_limits<double>::max();
   for (Marker& m : labels) {
     Eigen::Vector3d at(m.pose.position.x, m.pose.position.y, m.pose.position.z);
-    for (int i = 0; i < 1000 && !isFree(at); ++i)
+    const double width = halfWidth(m.text);
+    for (int i = 0; i < 1000 && !isFree(at, width); ++i)
       at -= 1.2 * line * up;
-    taken[cellOf(at)].push_back(at);
+    taken[cellOf(at)].push_back(Placed{at, width});
     m.pose.position = toPoint(at);
     top = std::max(top, at.dot(up));
   }

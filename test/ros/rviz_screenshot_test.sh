@@ -22,11 +22,11 @@ export LIBGL_ALWAYS_SOFTWARE=1
 export ROS_HOME="$OUT_DIR/ros_home"
 
 # case name | URDF | mode | expect red (1) or none (0). MA_URDF_DIR overrides where the models are read from.
+# The models of issue 11 whose view used to fail (door, SLE mast, Hoberman ring, millimetre Bennett), and the
+# Bennett of the README; the SLE mast is the exactly-constrained one (no red).
 URDF_DIR=${MA_URDF_DIR:-$SOURCE_DIR/urdf}
 CASES=(
   "bennett|$URDF_DIR/bennett.urdf|auto|1"
-  "puma560|$URDF_DIR/puma560.urdf|auto|0"
-  "four_bar_planar|$URDF_DIR/four_bar.urdf|planar|0"
   "door|$URDF_DIR/door.urdf|auto|1"
   "sle_mast|$URDF_DIR/sle_mast.urdf|planar|0"
   "hoberman_ring|$URDF_DIR/hoberman_ring.urdf|planar|1"
