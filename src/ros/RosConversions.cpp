@@ -1,10 +1,13 @@
 #include "mobility_analysis/ros/RosConversions.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <map>
 
-#include "mobility_analysis/UrdfLoader.hpp"
 #include "mobility_analysis/ElementClassification.h"
+#include "mobility_analysis/UrdfLoader.hpp"
 
 namespace mobility_analysis {
 
@@ -17,6 +20,8 @@ constexpr double kJointLength = 0.25;
 constexpr double kSphereDiameter = 0.1;
 constexpr double kTextHeight = 0.07;
 constexpr double kTitleHeight = 0.1;
+/// A link with more joint points than this is drawn as a star from its centroid, not as all pairs.
+constexpr size_t kMaxPlateCorners = 6;
 /// Two joint points closer than this fraction of the characteristic length are one point [-].
 constexpr double kSamePoint = 1e-6;
 
@@ -49,37 +54,72 @@ geometry_msgs::Quaternion toQuaternion(const Eigen::Quaterniond& q) {
 
 /// Rotation taking @p from onto the unit direction @p to (identity for a zero @p to).
 Eigen::Quaterniond rotationOnto(const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
-  if (to.norm() < 1e-12) return Eigen::Quaterniond::Identity();
+  if (to.norm() < 1e-12)
+    return Eigen::Quaterniond::Identity();
   return Eigen::Quaterniond::FromTwoVectors(from, to.normalized());
 }
 
 /// Joint-frame origins of connection @p j on both sides, in the root frame.
-std::pair<Eigen::Vector3d, Eigen::Vector3d> jointPoints(const Mechanism& mechanism, const LinkPoses& poses, int j) {
+std::pair<Eigen::Vector3d, Eigen::Vector3d> jointPoints(const Mechanism& mechanism, const LinkPoses& poses,
+                                                        int j) {
   const Joint& joint = mechanism.joints[j];
-  return {(poses[joint.link1] * joint.frame1).translation(), (poses[joint.link2] * joint.frame2).translation()};
+  return {(poses[joint.link1] * joint.frame1).translation(),
+          (poses[joint.link2] * joint.frame2).translation()};
 }
 
-/// Distinct points where link @p l meets its connections, in the root frame; its origin when it has none.
-std::vector<Eigen::Vector3d> linkPoints(const Mechanism& mechanism, const LinkPoses& poses, int l, double scale) {
-  std::vector<Eigen::Vector3d> points;
-  auto add = [&](const Eigen::Vector3d& p) {
-    for (const Eigen::Vector3d& q : points) {
-      if ((q - p).norm() < kSamePoint * scale) return;
-    }
-    points.push_back(p);
-  };
-  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
-    const Joint& joint = mechanism.joints[j];
-    if (joint.type == JointType::Floating && joint.kind == ConnectionKind::TreeJoint) continue;
-    if (joint.link1 == l) add((poses[l] * joint.frame1).translation());
-    if (joint.link2 == l) add((poses[l] * joint.frame2).translation());
+/**
+ * Distinct points where each link meets its connections, in the root frame (its origin when it has none): one
+ * pass over the connections, then per link a sort on the points' grid cells, so the whole is
+ * O(J log J) whatever the number of links (the marker builder of a 10^4-unit mast used to loop over every
+ * joint for every link).
+ */
+std::vector<std::vector<Eigen::Vector3d>> linkPoints(const Mechanism& mechanism, const LinkPoses& poses,
+                                                     double scale) {
+  std::vector<std::vector<Eigen::Vector3d>> points(mechanism.links.size());
+  for (const Joint& joint : mechanism.joints) {
+    if (joint.type == JointType::Floating && joint.kind == ConnectionKind::TreeJoint)
+      continue;
+    points[joint.link1].push_back((poses[joint.link1] * joint.frame1).translation());
+    points[joint.link2].push_back((poses[joint.link2] * joint.frame2).translation());
   }
-  if (points.empty()) add(poses[l].translation());
+  const double cell = kSamePoint * scale;
+  for (size_t l = 0; l < points.size(); ++l) {
+    std::vector<Eigen::Vector3d>& p = points[l];
+    if (p.empty()) {
+      p.push_back(poses[l].translation());
+      continue;
+    }
+    // Keep the first of the points that fall into one grid cell (points kSamePoint apart are one point).
+    auto key = [cell](const Eigen::Vector3d& v) {
+      return std::array<long long, 3>{std::llround(v.x() / cell), std::llround(v.y() / cell),
+                                      std::llround(v.z() / cell)};
+    };
+    std::vector<size_t> order(p.size());
+    for (size_t i = 0; i < order.size(); ++i)
+      order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(p[a]) < key(p[b]); });
+    std::vector<bool> keep(p.size(), false);
+    size_t kept = order.front();
+    keep[kept] = true;
+    for (size_t i = 1; i < order.size(); ++i) {
+      const Eigen::Vector3d& q = p[order[i]];
+      if (key(q) != key(p[order[i - 1]]) && (q - p[kept]).norm() >= cell) {
+        kept = order[i];
+        keep[kept] = true;
+      }
+    }
+    std::vector<Eigen::Vector3d> distinct;
+    for (size_t i = 0; i < p.size(); ++i) {
+      if (keep[i])
+        distinct.push_back(p[i]);
+    }
+    p.swap(distinct);
+  }
   return points;
 }
 
-visualization_msgs::Marker makeMarker(const std::string& frame, const ros::Time& stamp, const char* ns, int id,
-                                      int type, const std_msgs::ColorRGBA& color) {
+visualization_msgs::Marker makeMarker(const std::string& frame, const ros::Time& stamp, const char* ns,
+                                      int id, int type, const std_msgs::ColorRGBA& color) {
   visualization_msgs::Marker marker;
   marker.header.frame_id = frame;
   marker.header.stamp = stamp;
@@ -107,12 +147,63 @@ void toDofFields(const MobilityReport& report, Response& response) {
   response.num_constraints = report.numConstraints;
   response.rank = report.rank;
   response.num_redundant = report.numRedundant;
+  response.finite_dof = report.finiteDof;
+  response.singular = report.singular;
+  response.passive_dof = report.passiveDof;
+  response.output_dof = report.outputDof;
+  response.passive_motions.clear();
+  for (const PassiveMotion& p : report.passiveMotions) {
+    PassiveGroup m;
+    m.links = p.links;
+    m.description = p.description;
+    response.passive_motions.push_back(m);
+  }
   response.nullity_trace.assign(report.nullityTrace.begin(), report.nullityTrace.end());
+  response.positions.clear();
+  response.positions.reserve(report.positions.size());
+  for (const JointValue& v : report.positions) {
+    TreeJointValue m;
+    m.name = v.name;
+    m.value = v.value;
+    response.positions.push_back(m);
+  }
+  response.assembly.residual = report.assembly.residual;
+  response.assembly.steps = report.assembly.steps;
+  response.assembly.iterations = report.assembly.iterations;
+  response.assembly.events = report.assembly.events;
+  response.warnings = report.warnings;
 }
 
+template <class Response>
+void fromDofFields(const Response& response, MobilityReport& report) {
+  report.robot = response.robot;
+  report.mode = response.mode;
+  report.lambda = response.lambda;
+  report.dof = response.dof;
+  report.grublerKutzbachDof = response.grubler_kutzbach_dof;
+  report.numCoordinates = response.num_coordinates;
+  report.numConstraints = response.num_constraints;
+  report.rank = response.rank;
+  report.numRedundant = response.num_redundant;
+  report.finiteDof = response.finite_dof;
+  report.singular = response.singular;
+  report.passiveDof = response.passive_dof;
+  report.outputDof = response.output_dof;
+  report.passiveMotions.clear();
+  for (const auto& p : response.passive_motions)
+    report.passiveMotions.push_back(PassiveMotion{p.links, p.description});
+  report.nullityTrace.assign(response.nullity_trace.begin(), response.nullity_trace.end());
+  report.positions.clear();
+  for (const auto& v : response.positions)
+    report.positions.push_back(JointValue{v.name, v.value});
+  report.assembly.residual = response.assembly.residual;
+  report.assembly.steps = response.assembly.steps;
+  report.assembly.iterations = response.assembly.iterations;
+  report.assembly.events = response.assembly.events;
+  report.warnings = response.warnings;
+}
 
-std::vector<ElementClassification> toStatusMessages(
-    const std::vector<ElementStatus>& statuses) {
+std::vector<ElementClassification> toStatusMessages(const std::vector<ElementStatus>& statuses) {
   std::vector<ElementClassification> out;
   out.reserve(statuses.size());
   for (const ElementStatus& s : statuses) {
@@ -132,7 +223,8 @@ ElementStatus fromStatus(const ElementClassification& status) {
 
 template <class Request>
 Result<JointPositions> positionsOf(const Request& request, const Mechanism& mechanism) {
-  if (request.joint_names.empty() && request.positions.empty()) return JointPositions{};
+  if (request.joint_names.empty() && request.positions.empty())
+    return JointPositions{};
   return makeJointPositions(request.joint_names, request.positions, mechanism);
 }
 
@@ -140,16 +232,21 @@ Result<JointPositions> positionsOf(const Request& request, const Mechanism& mech
 
 std_msgs::ColorRGBA toColor(ElementClass elementClass, bool isLink) {
   switch (elementClass) {
-    case ElementClass::Redundant: return makeColor(1.0f, 0.0f, 0.0f);
-    case ElementClass::OverConstrainedLoop: return makeColor(1.0f, 0.5f, 0.0f);
-    case ElementClass::Neutral: break;
+    case ElementClass::Redundant:
+      return makeColor(1.0f, 0.0f, 0.0f);
+    case ElementClass::OverConstrainedLoop:
+      return makeColor(1.0f, 0.5f, 0.0f);
+    case ElementClass::Neutral:
+      break;
   }
   return isLink ? makeColor(0.65f, 0.65f, 0.7f) : makeColor(0.2f, 0.45f, 0.95f);
 }
 
 ElementClass fromClassName(const std::string& name) {
-  if (name == toString(ElementClass::Redundant)) return ElementClass::Redundant;
-  if (name == toString(ElementClass::OverConstrainedLoop)) return ElementClass::OverConstrainedLoop;
+  if (name == toString(ElementClass::Redundant))
+    return ElementClass::Redundant;
+  if (name == toString(ElementClass::OverConstrainedLoop))
+    return ElementClass::OverConstrainedLoop;
   return ElementClass::Neutral;
 }
 
@@ -162,17 +259,23 @@ geometry_msgs::Pose toPose(const Eigen::Isometry3d& pose) {
 
 Eigen::Isometry3d fromTransform(const geometry_msgs::Transform& transform) {
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.translation() = Eigen::Vector3d(transform.translation.x, transform.translation.y, transform.translation.z);
-  out.linear() =
-      Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y, transform.rotation.z)
-          .normalized()
-          .toRotationMatrix();
+  out.translation() =
+      Eigen::Vector3d(transform.translation.x, transform.translation.y, transform.translation.z);
+  out.linear() = Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y,
+                                    transform.rotation.z)
+                     .normalized()
+                     .toRotationMatrix();
   return out;
 }
 
-void toResponse(const MobilityReport& report, GetDof::Response& response) { toDofFields(report, response); }
+void toResponse(const MobilityReport& report, GetDof::Response& response) {
+  toDofFields(report, response);
+}
 
-void toResponse(const MobilityReport& report, GetRedundancy::Response& response) {
+namespace {
+
+template <class Response>
+void toReportFields(const MobilityReport& report, Response& response) {
   toDofFields(report, response);
   response.file = report.file;
   response.redundant_constraints.clear();
@@ -184,6 +287,7 @@ void toResponse(const MobilityReport& report, GetRedundancy::Response& response)
     m.name = c.name;
     m.kind = c.kind;
     m.equation = c.equation;
+    m.cause = c.cause;
     response.redundant_constraints.push_back(m);
   }
   response.redundant_joints.clear();
@@ -218,30 +322,14 @@ void toResponse(const MobilityReport& report, GetRedundancy::Response& response)
   response.closure_residual_after = report.closureResidualAfter;
 }
 
-void toResponse(const MobilityReport& report, LoadRobot::Response& response) {
-  response.success = true;
-  response.message.clear();
-  response.robot = report.robot;
-  response.dof = report.dof;
-  response.grubler_kutzbach_dof = report.grublerKutzbachDof;
-  response.num_redundant = report.numRedundant;
-}
-
-MobilityReport fromResponse(const GetRedundancy::Response& response) {
+template <class Response>
+MobilityReport fromReportFields(const Response& response) {
   MobilityReport report;
-  report.robot = response.robot;
+  fromDofFields(response, report);
   report.file = response.file;
-  report.mode = response.mode;
-  report.lambda = response.lambda;
-  report.dof = response.dof;
-  report.grublerKutzbachDof = response.grubler_kutzbach_dof;
-  report.numCoordinates = response.num_coordinates;
-  report.numConstraints = response.num_constraints;
-  report.rank = response.rank;
-  report.numRedundant = response.num_redundant;
-  report.nullityTrace.assign(response.nullity_trace.begin(), response.nullity_trace.end());
   for (const auto& c : response.redundant_constraints) {
-    report.redundantConstraints.push_back(RedundantConstraint{c.index, c.source, c.name, c.kind, c.equation});
+    report.redundantConstraints.push_back(
+        RedundantConstraint{c.index, c.source, c.name, c.kind, c.equation, c.cause});
   }
   for (const auto& j : response.redundant_joints) {
     report.redundantJoints.push_back(RedundantJoint{j.name, j.redundant_equations, j.equations});
@@ -249,8 +337,10 @@ MobilityReport fromResponse(const GetRedundancy::Response& response) {
   report.redundantLinks = response.redundant_links;
   report.redundantLinksComputed = response.redundant_links_computed;
   report.redundantBoundaries = response.redundant_boundaries;
-  for (const auto& s : response.links) report.links.push_back(fromStatus(s));
-  for (const auto& s : response.joints) report.joints.push_back(fromStatus(s));
+  for (const auto& s : response.links)
+    report.links.push_back(fromStatus(s));
+  for (const auto& s : response.joints)
+    report.joints.push_back(fromStatus(s));
   for (const auto& c : response.cables) {
     report.cables.push_back(CableState{c.name, c.type, c.state, c.length, c.distance});
   }
@@ -262,6 +352,30 @@ MobilityReport fromResponse(const GetRedundancy::Response& response) {
   report.closureResidualBefore = response.closure_residual_before;
   report.closureResidualAfter = response.closure_residual_after;
   return report;
+}
+
+}  // namespace
+
+void toResponse(const MobilityReport& report, GetRedundancy::Response& response) {
+  toReportFields(report, response);
+}
+
+void toResponse(const MobilityReport& report, LoadRobot::Response& response) {
+  toReportFields(report, response);
+}
+
+MobilityReport fromResponse(const GetDof::Response& response) {
+  MobilityReport report;
+  fromDofFields(response, report);
+  return report;
+}
+
+MobilityReport fromResponse(const GetRedundancy::Response& response) {
+  return fromReportFields(response);
+}
+
+MobilityReport fromResponse(const LoadRobot::Response& response) {
+  return fromReportFields(response);
 }
 
 Result<JointPositions> fromRequest(const GetDof::Request& request, const Mechanism& mechanism) {
@@ -278,7 +392,8 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   const double scale = report.characteristicLength > 0.0 && std::isfinite(report.characteristicLength)
                            ? report.characteristicLength
                            : 1.0;
-  const std::string frame = mechanism.links.empty() ? std::string() : mechanism.links[mechanism.rootLink].name;
+  const std::string frame =
+      mechanism.links.empty() ? std::string() : mechanism.links[mechanism.rootLink].name;
   const int numLinks = static_cast<int>(mechanism.links.size());
   auto classOf = [](const std::vector<ElementStatus>& statuses, size_t i) {
     return i < statuses.size() ? statuses[i].elementClass : ElementClass::Neutral;
@@ -292,7 +407,8 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   std::vector<Marker> labels;
   Eigen::Vector3d lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
   Eigen::Vector3d upper = -lower;
-  auto label = [&](int id, const std::string& text, const Eigen::Vector3d& at, const std_msgs::ColorRGBA& color) {
+  auto label = [&](int id, const std::string& text, const Eigen::Vector3d& at,
+                   const std_msgs::ColorRGBA& color) {
     Marker m = makeMarker(frame, stamp, kLabelsNamespace, id, Marker::TEXT_VIEW_FACING, color);
     m.pose.position = toPoint(at);
     m.scale.x = m.scale.y = m.scale.z = kTextHeight * scale;
@@ -300,9 +416,30 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
     labels.push_back(m);
   };
 
+  const std::vector<std::vector<Eigen::Vector3d>> allPoints = linkPoints(mechanism, poses, scale);
+  // Labels are pushed away from the model's centre (and joint labels off the joint's axis), so that they
+  // stand beside the geometry rather than inside it, and neighbouring labels part.
+  Eigen::Vector3d modelCentre = Eigen::Vector3d::Zero();
+  size_t numPoints = 0;
+  for (const auto& points : allPoints) {
+    for (const Eigen::Vector3d& p : points)
+      modelCentre += p;
+    numPoints += points.size();
+  }
+  if (numPoints > 0)
+    modelCentre /= static_cast<double>(numPoints);
+  auto outward = [&](const Eigen::Vector3d& at, const Eigen::Vector3d& axis) {
+    Eigen::Vector3d d = at - modelCentre;
+    if (axis.norm() > 0.0)
+      d -= d.dot(axis.normalized()) * axis.normalized();
+    if (d.norm() < kSamePoint * scale)
+      d = axis.norm() > 0.0 ? axis.unitOrthogonal() : Eigen::Vector3d::UnitZ();
+    return Eigen::Vector3d(d.normalized());
+  };
+  auto halfWidth = [&](const std::string& text) { return 0.3 * kTextHeight * scale * text.size(); };
   for (int l = 0; l < numLinks; ++l) {
     const std_msgs::ColorRGBA color = toColor(classOf(report.links, l), true);
-    const std::vector<Eigen::Vector3d> points = linkPoints(mechanism, poses, l, scale);
+    const std::vector<Eigen::Vector3d>& points = allPoints[l];
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& p : points) {
       centroid += p;
@@ -316,18 +453,30 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
       m.scale.x = m.scale.y = m.scale.z = 0.6 * kSphereDiameter * scale;
       array.markers.push_back(m);
     } else {
-      // Every pair of joint points: a binary link is one bar, a ternary link a triangle (the lecture's plates).
+      // Every pair of joint points: a binary link is one bar, a ternary link a triangle (the lecture's
+      // plates). Beyond kMaxPlateCorners points a star from the centroid, so the marker stays linear in the
+      // points.
       Marker m = makeMarker(frame, stamp, kLinksNamespace, l, Marker::LINE_LIST, color);
       m.scale.x = m.scale.y = m.scale.z = kLinkWidth * scale;
-      for (size_t a = 0; a < points.size(); ++a) {
-        for (size_t b = a + 1; b < points.size(); ++b) {
-          m.points.push_back(toPoint(points[a]));
-          m.points.push_back(toPoint(points[b]));
+      if (points.size() <= kMaxPlateCorners) {
+        for (size_t a = 0; a < points.size(); ++a) {
+          for (size_t b = a + 1; b < points.size(); ++b) {
+            m.points.push_back(toPoint(points[a]));
+            m.points.push_back(toPoint(points[b]));
+          }
+        }
+      } else {
+        for (const Eigen::Vector3d& p : points) {
+          m.points.push_back(toPoint(centroid));
+          m.points.push_back(toPoint(p));
         }
       }
       array.markers.push_back(m);
     }
-    label(l, mechanism.links[l].name, centroid + Eigen::Vector3d(0, 0, 0.6 * kTextHeight * scale), color);
+    label(l, mechanism.links[l].name,
+          centroid +
+              (kJointDiameter * scale + kTextHeight * scale) * outward(centroid, Eigen::Vector3d::Zero()),
+          color);
   }
 
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
@@ -339,7 +488,8 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
     Marker m = makeMarker(frame, stamp, kJointsNamespace, id, Marker::SPHERE, color);
     m.pose.position = toPoint(p2);
     m.scale.x = m.scale.y = m.scale.z = kSphereDiameter * scale;
-    const bool isRod = joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable;
+    const bool isRod =
+        joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable;
     if (isRod && (p1 - p2).norm() > kSamePoint * scale) {
       m.type = Marker::LINE_LIST;
       m.pose.position = geometry_msgs::Point();
@@ -367,7 +517,8 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
         case JointType::Fixed:
         case JointType::Planar:
           m.type = Marker::CUBE;
-          m.pose.orientation = toQuaternion(Eigen::Quaterniond((poses[joint.link2] * joint.frame2).rotation()));
+          m.pose.orientation =
+              toQuaternion(Eigen::Quaterniond((poses[joint.link2] * joint.frame2).rotation()));
           m.scale.x = m.scale.y = m.scale.z = 0.8 * kSphereDiameter * scale;
           break;
         case JointType::Spherical:
@@ -381,19 +532,82 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
     array.markers.push_back(m);
     lower = lower.cwiseMin(p2);
     upper = upper.cwiseMax(p2);
-    label(numLinks + id, joint.name, p2 + Eigen::Vector3d(0, 0, 1.2 * kSphereDiameter * scale), color);
+    // Beside the joint, off its axis (a label on a hinge's axis hides in its cylinder).
+    const bool hasAxis = joint.type == JointType::Revolute || joint.type == JointType::Continuous ||
+                         joint.type == JointType::Cylindrical || joint.type == JointType::Prismatic;
+    label(numLinks + id, joint.name,
+          p2 + (kSphereDiameter * scale + halfWidth(joint.name)) *
+                   outward(p2, hasAxis ? axis : Eigen::Vector3d::Zero()),
+          color);
+  }
+  // Labels that fall on one another (a door and its frame share their joint points) part downwards: the first
+  // keeps its place, the next moves one line down until its cell is free.
+  const Eigen::Vector3d extent = upper - lower;
+  const bool flat = extent.z() < 0.2 * std::max(extent.x(), extent.y());  // Viewed from above, +y up.
+  const Eigen::Vector3d up = flat ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+  const double line = kTextHeight * scale;
+  // Two labels overlap when they are less than a line apart along `up` and their texts (about 0.6 text
+  // heights per character, centred) meet across it. Cells of the widest text keep the search local.
+  size_t longest = 1;
+  for (const Marker& m : labels)
+    longest = std::max(longest, m.text.size());
+  const double cellSize = std::max(line, 2.0 * halfWidth(std::string(longest, 'x')));
+  struct Placed {
+    Eigen::Vector3d at;
+    double halfWidth;
+  };
+  std::map<std::array<long long, 3>, std::vector<Placed>> taken;  // Placed labels by grid cell.
+  auto cellOf = [&](const Eigen::Vector3d& at) {
+    return std::array<long long, 3>{std::llround(at.x() / cellSize), std::llround(at.y() / cellSize),
+                                    std::llround(at.z() / cellSize)};
+  };
+  auto isFree = [&](const Eigen::Vector3d& at, double width) {
+    const std::array<long long, 3> c = cellOf(at);
+    for (long long dx = -1; dx <= 1; ++dx) {
+      for (long long dy = -1; dy <= 1; ++dy) {
+        for (long long dz = -1; dz <= 1; ++dz) {
+          const auto found = taken.find({c[0] + dx, c[1] + dy, c[2] + dz});
+          if (found == taken.end())
+            continue;
+          for (const Placed& other : found->second) {
+            const Eigen::Vector3d d = other.at - at;
+            const double along = d.dot(up);
+            if (std::abs(along) < 0.9 * line && (d - along * up).norm() < width + other.halfWidth)
+              return false;
+          }
+        }
+      }
+    }
+    return true;
+  };
+  double top = -std::numeric_limits<double>::max();
+  for (Marker& m : labels) {
+    Eigen::Vector3d at(m.pose.position.x, m.pose.position.y, m.pose.position.z);
+    const double width = halfWidth(m.text);
+    for (int i = 0; i < 1000 && !isFree(at, width); ++i)
+      at -= 1.2 * line * up;
+    taken[cellOf(at)].push_back(Placed{at, width});
+    m.pose.position = toPoint(at);
+    top = std::max(top, at.dot(up));
   }
   array.markers.insert(array.markers.end(), labels.begin(), labels.end());
 
   if (!mechanism.links.empty()) {
     char text[160];
-    std::snprintf(text, sizeof(text), "%s: DOF %d (Gr\xC3\xBC"
+    std::snprintf(text, sizeof(text),
+                  "%s: DOF %d (Gr\xC3\xBC"
                   "bler %d), %d redundant",
                   report.robot.c_str(), report.dof, report.grublerKutzbachDof, report.numRedundant);
-    Marker title = makeMarker(frame, stamp, kTitleNamespace, 0, Marker::TEXT_VIEW_FACING,
-                              makeColor(1.0f, 1.0f, 1.0f));
-    title.pose.position = toPoint(Eigen::Vector3d(0.5 * (lower.x() + upper.x()), 0.5 * (lower.y() + upper.y()),
-                                                  upper.z() + 2.5 * kTitleHeight * scale));
+    Marker title =
+        makeMarker(frame, stamp, kTitleNamespace, 0, Marker::TEXT_VIEW_FACING, makeColor(1.0f, 1.0f, 1.0f));
+    // Above the model and its labels: over its top, or beyond its +y edge when it lies flat (mobility_viewer
+    // then looks down with +y up the screen).
+    Eigen::Vector3d at = 0.5 * (lower + upper);
+    if (flat)
+      at.z() = upper.z();
+    const double height = std::max(top, upper.dot(up)) + 1.5 * kTitleHeight * scale;
+    at += (height - at.dot(up)) * up;
+    title.pose.position = toPoint(at);
     title.scale.x = title.scale.y = title.scale.z = kTitleHeight * scale;
     title.text = text;
     array.markers.push_back(title);
@@ -401,10 +615,24 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   return array;
 }
 
+sensor_msgs::JointState toJointState(const MobilityReport& report, const ros::Time& stamp) {
+  sensor_msgs::JointState state;
+  state.header.stamp = stamp;
+  state.name.reserve(report.positions.size());
+  state.position.reserve(report.positions.size());
+  for (const JointValue& v : report.positions) {
+    state.name.push_back(v.name);
+    state.position.push_back(v.value);
+  }
+  return state;
+}
+
 std::vector<geometry_msgs::TransformStamped> toTransforms(const Mechanism& mechanism, const LinkPoses& poses,
-                                                          const std::string& fixedFrame, const ros::Time& stamp) {
+                                                          const std::string& fixedFrame,
+                                                          const ros::Time& stamp, LinkFrames frames) {
   std::vector<geometry_msgs::TransformStamped> transforms;
-  if (mechanism.links.empty()) return transforms;
+  if (mechanism.links.empty())
+    return transforms;
   const std::string& root = mechanism.links[mechanism.rootLink].name;
   auto add = [&](const std::string& parent, const std::string& child, const Eigen::Isometry3d& pose) {
     geometry_msgs::TransformStamped t;
@@ -419,10 +647,22 @@ std::vector<geometry_msgs::TransformStamped> toTransforms(const Mechanism& mecha
     transforms.push_back(t);
   };
   const bool fixedIsLink = mechanism.findLink(fixedFrame).has_value();
-  if (!fixedFrame.empty() && !fixedIsLink) add(fixedFrame, root, Eigen::Isometry3d::Identity());
-  for (size_t l = 0; l < mechanism.links.size(); ++l) {
-    if (static_cast<int>(l) == mechanism.rootLink) continue;
-    add(root, mechanism.links[l].name, poses[l]);
+  if (!fixedFrame.empty() && !fixedIsLink)
+    add(fixedFrame, root, Eigen::Isometry3d::Identity());
+  if (frames == LinkFrames::All) {
+    transforms.reserve(mechanism.links.size() + 1);
+    for (size_t l = 0; l < mechanism.links.size(); ++l) {
+      if (static_cast<int>(l) == mechanism.rootLink)
+        continue;
+      add(root, mechanism.links[l].name, poses[l]);
+    }
+    return transforms;
+  }
+  for (const Joint& joint : mechanism.joints) {
+    if (joint.kind != ConnectionKind::TreeJoint || joint.type != JointType::Floating)
+      continue;
+    add(mechanism.links[joint.link1].name, mechanism.links[joint.link2].name,
+        poses[joint.link1].inverse() * poses[joint.link2]);
   }
   return transforms;
 }

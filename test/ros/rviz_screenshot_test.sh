@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# rviz, as a user sees it: starts launch/mobility.launch (node + rviz) under Xvfb for each model below, takes a
-# screenshot of the whole screen and asserts that an over-constrained model shows red (redundant elements, colour
-# (1, 0, 0)) and an exactly-constrained one shows none. PNGs are kept in BUILD_DIR/rviz_screenshots/.
+# rviz, as a user sees it: starts launch/mobility.launch (node, robot_state_publisher, mobility_viewer + rviz)
+# under Xvfb for each model below, takes a screenshot of the whole screen and asserts that an over-constrained
+# model shows red (redundant elements, colour (1, 0, 0)) and an exactly-constrained one shows none, and that every
+# label and the title project inside rviz's 3D view with the camera mobility_viewer framed
+# (check_label_projection.py). PNGs are kept in BUILD_DIR/rviz_screenshots/.
 #
 #   test/ros/rviz_screenshot_test.sh [BUILD_DIR]      (default: build; needs a built package in BUILD_DIR/devel)
 #
@@ -20,11 +22,15 @@ export LIBGL_ALWAYS_SOFTWARE=1
 export ROS_HOME="$OUT_DIR/ros_home"
 
 # case name | URDF | mode | expect red (1) or none (0). MA_URDF_DIR overrides where the models are read from.
+# The models of issue 11 whose view used to fail (door, SLE mast, Hoberman ring, millimetre Bennett), and the
+# Bennett of the README; the SLE mast is the exactly-constrained one (no red).
 URDF_DIR=${MA_URDF_DIR:-$SOURCE_DIR/urdf}
 CASES=(
   "bennett|$URDF_DIR/bennett.urdf|auto|1"
-  "puma560|$URDF_DIR/puma560.urdf|auto|0"
-  "four_bar_planar|$URDF_DIR/four_bar.urdf|planar|0"
+  "door|$URDF_DIR/door.urdf|auto|1"
+  "sle_mast|$URDF_DIR/sle_mast.urdf|planar|0"
+  "hoberman_ring|$URDF_DIR/hoberman_ring.urdf|planar|1"
+  "bennett_mm|$URDF_DIR/bennett_mm.urdf|auto|1"
 )
 # A pixel is "red" when it is the marker red, lit or not: strong red, little green and blue. Orange (1, 0.5, 0)
 # keeps g/r = 0.5 and the neutral grey/blue colours have large g or b, so neither counts.
@@ -61,6 +67,7 @@ for entry in "${CASES[@]}"; do
     failures=$((failures + 1))
     continue
   fi
+  rm -f "$ROS_HOME/mobility_view.rviz"
   display=$(free_display)
   Xvfb ":$display" -screen 0 1280x900x24 -nolisten tcp >"$OUT_DIR/$name.xvfb.log" 2>&1 &
   XVFB_PID=$!
@@ -105,9 +112,21 @@ for entry in "${CASES[@]}"; do
     cp "$png" "$OUT_DIR/$name.view.png"
   fi
   red=$(convert "$OUT_DIR/$name.view.png" -fx "$RED_FX" -format '%[fx:round(mean*w*h)]' info: 2>/dev/null || echo -1)
+  # Every label inside the 3D view, projected with the camera the viewer wrote.
+  size=${view%%+*}
+  [ -n "$size" ] || size=1280x900
+  labels_ok=0
+  if /usr/bin/python3 "$SOURCE_DIR/test/ros/check_label_projection.py" "$ROS_HOME/mobility_view.rviz" "$size" \
+      >"$OUT_DIR/$name.labels.txt" 2>&1; then
+    labels_ok=1
+  fi
+  labels_summary=$(tail -n 1 "$OUT_DIR/$name.labels.txt")
   cleanup
   if [ "$ok" != 1 ] || [ "$window" != 1 ] || [ "$red" -lt 0 ]; then
     echo "FAIL rviz screenshot $name: service=$ok window=$window red=$red (see $log)"
+    failures=$((failures + 1))
+  elif [ "$labels_ok" != 1 ]; then
+    echo "FAIL rviz screenshot $name: $labels_summary (see $OUT_DIR/$name.labels.txt, $png)"
     failures=$((failures + 1))
   elif [ "$expect_red" = 1 ] && [ "$red" -lt "$MIN_RED_PIXELS" ]; then
     echo "FAIL rviz screenshot $name: over-constrained but only $red red pixels ($png)"
@@ -116,7 +135,7 @@ for entry in "${CASES[@]}"; do
     echo "FAIL rviz screenshot $name: exactly constrained but $red red pixels ($png)"
     failures=$((failures + 1))
   else
-    echo "PASS rviz screenshot $name: $red red pixels in the 3D view $view, expected $([ "$expect_red" = 1 ] && echo "some" || echo "none") ($png)"
+    echo "PASS rviz screenshot $name: $red red pixels in the 3D view $view, expected $([ "$expect_red" = 1 ] && echo "some" || echo "none"); $labels_summary ($png)"
   fi
 done
 exit $((failures > 0))

@@ -13,6 +13,7 @@
 #include <mutex>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -442,6 +443,35 @@ TEST(MobilityServer, loadRobotSwapsOnlyOnSuccessAndRepublishes) {
   ASSERT_TRUE(call("load_robot", restore));
   ASSERT_TRUE(restore.response.success) << restore.response.message;
   EXPECT_EQ(restore.response.num_redundant, expected.numRedundant);
+}
+
+TEST(MobilityServer, theLoadRobotToolLoadsEveryBundledModel) {
+  // The README's load_robot example: nodes/load_robot sends the file as it is (apostrophes and all, which broke
+  // the YAML one-liner on 5 of the bundled files) and prints what the node now serves.
+  const std::string tool = std::string(MA_SOURCE_DIR) + "/nodes/load_robot";
+  ASSERT_EQ(access(tool.c_str(), X_OK), 0) << tool;
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(MA_URDF_DIR)) {
+    if (entry.path().extension() != ".urdf") continue;
+    ++files;
+    SCOPED_TRACE(entry.path().string());
+    const Mechanism mechanism = valueOf(loadMechanismFromFile(entry.path().string()));
+    const auto [out, status] =
+        run("/usr/bin/python3 " + tool + " '" + entry.path().string() + "' --server " + config.server + " 2>&1");
+    EXPECT_EQ(status, 0) << out;
+    EXPECT_EQ(out.rfind(mechanism.name + ": DOF ", 0), 0u) << out;
+  }
+  EXPECT_GE(files, 10);
+  const auto [bad, status] = run("/usr/bin/python3 " + tool + " '" + std::string(MA_FIXTURE_DIR) +
+                                 "/ros_bad_unknown_link.urdf' --server " + config.server + " 2>&1");
+  EXPECT_EQ(status, 2) << bad;
+  EXPECT_NE(bad.find("rockr"), std::string::npos) << bad;
+  // Restore the launched model for the other tests.
+  LoadRobot restore;
+  restore.request.urdf = readFile(config.urdfFile);
+  restore.request.mode = config.modeText;
+  ASSERT_TRUE(call("load_robot", restore));
+  ASSERT_TRUE(restore.response.success) << restore.response.message;
 }
 
 TEST(MobilityServer, thousandRapidCallsKeepTheNodeAliveAndItsMemoryFlat) {

@@ -6,14 +6,15 @@
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>
+#include <sensor_msgs/JointState.h>
 #include <std_msgs/ColorRGBA.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "mobility_analysis/Diagnostic.hpp"
 #include "mobility_analysis/GetDof.h"
 #include "mobility_analysis/GetRedundancy.h"
-#include "mobility_analysis/LoadRobot.h"
-#include "mobility_analysis/Diagnostic.hpp"
 #include "mobility_analysis/Kinematics.hpp"
+#include "mobility_analysis/LoadRobot.h"
 #include "mobility_analysis/Mechanism.hpp"
 #include "mobility_analysis/MobilityReport.hpp"
 
@@ -56,7 +57,7 @@ void toResponse(const MobilityReport& report, GetDof::Response& response);
 /// @brief Fills every report field of a GetRedundancy response (success = true, message empty).
 void toResponse(const MobilityReport& report, GetRedundancy::Response& response);
 
-/// @brief Fills the summary of a LoadRobot response (success = true, message empty).
+/// @brief Fills every report field of a LoadRobot response (success = true, message empty): the full report.
 void toResponse(const MobilityReport& report, LoadRobot::Response& response);
 
 /**
@@ -70,10 +71,22 @@ void toFailure(const Diagnostic& diagnostic, Response& response) {
 }
 
 /**
- * @brief The report carried by a GetRedundancy response, inverse of toResponse: toJson(fromResponse(r)) equals
- *        the CLI's `--json` output for the same model (the file field is whatever the server was given).
+ * @brief The report carried by a GetRedundancy response, inverse of toResponse: toJson(fromResponse(r))
+ * equals the CLI's `--json` output for the same model (the file field is whatever the server was given).
  */
 MobilityReport fromResponse(const GetRedundancy::Response& response);
+/// @copydoc fromResponse(const GetRedundancy::Response&)
+MobilityReport fromResponse(const LoadRobot::Response& response);
+/// @return The report fields a GetDof response carries (the redundancy lists, classes and cables stay empty).
+MobilityReport fromResponse(const GetDof::Response& response);
+
+/**
+ * @brief The `joint_states` message of a state: every 1-DOF tree joint of the report's `positions`, in
+ * document order, as robot_state_publisher wants them.
+ * @param[in] report the report of the state.
+ * @param[in] stamp the stamp of the input the state answers (or now).
+ */
+sensor_msgs::JointState toJointState(const MobilityReport& report, const ros::Time& stamp);
 
 /**
  * @brief The joint positions of a service request, checked against @p mechanism (sizes, names, finiteness).
@@ -90,26 +103,40 @@ Result<JointPositions> fromRequest(const GetRedundancy::Request& request, const 
  * (a SPHERE when it has fewer than two distinct points), per connection (ns `joints`, id = joint index) a
  * CYLINDER along a revolute/continuous/cylindrical axis, an ARROW along a prismatic axis, a SPHERE for a
  * spherical or floating joint, a CUBE for universal/fixed/planar joints and a LINE_LIST for distance
- * constraints and cables; per element a TEXT_VIEW_FACING label (ns `labels`, id = link index, then number of
- * links + joint index) with text = name and colour = the element's colour; and one title label (ns `title`).
- * Sizes scale with the report's characteristic length; no scale is zero, every quaternion is normalised.
+ * constraints and cables (a link with more than six distinct joint points is a star from its centroid; the
+ * whole array is built in O(J log J)); per element a TEXT_VIEW_FACING label (ns `labels`, id = link index,
+ * then number of links + joint index) with text = name and colour = the element's colour; and one title label
+ * (ns `title`). Sizes scale with the report's characteristic length; no scale is zero, every quaternion is
+ * normalised.
  * @param[in] mechanism the mechanism.
  * @param[in] poses link poses in the root frame (dim mechanism.links.size()).
  * @param[in] report the report whose links/joints classes decide the colours (same indexing as mechanism).
  * @param[in] stamp header stamp (ros::Time(0): the latest transform).
  */
 visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const LinkPoses& poses,
-                                              const MobilityReport& report, const ros::Time& stamp = ros::Time(0));
+                                              const MobilityReport& report,
+                                              const ros::Time& stamp = ros::Time(0));
+
+/// Which link frames the node broadcasts itself.
+enum class LinkFrames {
+  All,          ///< Every non-root link from the root (no robot_state_publisher beside the node).
+  FloatingHung  ///< Only links hung from their tree parent by a floating joint, from that parent: the ones
+                ///< robot_state_publisher does not publish (it publishes the others from joint_states).
+};
 
 /**
- * @brief One transform per non-root link, parent = root link, child = link name (tf frame ids are the URDF link
- *        names), plus `fixedFrame` -> root as identity when @p fixedFrame is non-empty and not a link name.
+ * @brief The link transforms of a state (tf frame ids are the URDF link names), plus `fixedFrame` -> root as
+ *        identity when @p fixedFrame is non-empty and not a link name.
  * @param[in] mechanism the mechanism (names, root).
  * @param[in] poses link poses in the root frame.
  * @param[in] fixedFrame a frame rviz can always use as Fixed Frame ("mobility_world"), or empty.
  * @param[in] stamp header stamp.
+ * @param[in] frames All: root -> every non-root link; FloatingHung: tree parent -> child of every floating
+ * tree joint.
  */
 std::vector<geometry_msgs::TransformStamped> toTransforms(const Mechanism& mechanism, const LinkPoses& poses,
-                                                          const std::string& fixedFrame, const ros::Time& stamp);
+                                                          const std::string& fixedFrame,
+                                                          const ros::Time& stamp,
+                                                          LinkFrames frames = LinkFrames::All);
 
 }  // namespace mobility_analysis
