@@ -37,6 +37,45 @@ int residualRows(JointType type) {
   return 0;
 }
 
+/// Value of 1-DOF tree joint @p j at @p poses in the unknowns' units: [rad], or [Lc] for a slide.
+double unknownValue(const Joint& joint, const LinkPoses& poses, double lc) {
+  const Eigen::Isometry3d motion =
+      (poses[joint.link1] * joint.frame1).inverse() * poses[joint.link2] * joint.frame2;
+  if (joint.type == JointType::Prismatic)
+    return joint.axis.dot(motion.translation()) / lc;
+  const Eigen::Vector3d v = joint.axis.unitOrthogonal();
+  const Eigen::Vector3d turned = motion.linear() * v;
+  return std::atan2(joint.axis.dot(v.cross(turned)), v.dot(turned));
+}
+
+/**
+ * @brief A coupling value(f) = m value(l) + c in the tree's own unknowns: linear, one row, written in the
+ *        follower's unknown (so its derivative there is 1). A turning follower's residual is taken modulo a
+ *        turn, since its angle is read from the poses.
+ */
+void addCouplingRow(const Mechanism& mechanism, const ClosureLayout& layout, const LinkPoses& poses,
+                    const Joint& coupling, const std::vector<int>& columns, int row, Eigen::VectorXd& residual,
+                    std::vector<Eigen::Triplet<double>>* triplets) {
+  const double lc = layout.lengthScale;
+  const Joint& follower = mechanism.joints[coupling.follower];
+  const Joint& leader = mechanism.joints[coupling.leader];
+  const double followerScale = follower.type == JointType::Prismatic ? lc : 1.0;
+  const double leaderScale = leader.type == JointType::Prismatic ? lc : 1.0;
+  double r = unknownValue(follower, poses, lc) -
+             (coupling.multiplier * unknownValue(leader, poses, lc) * leaderScale + coupling.offset) / followerScale;
+  if (follower.type != JointType::Prismatic)
+    r = std::remainder(r, 2.0 * M_PI);
+  residual(row) = r;
+  if (triplets == nullptr)
+    return;
+  const int fc = columns[layout.unknownOffset[coupling.follower]];
+  const int lcol = columns[layout.unknownOffset[coupling.leader]];
+  if (fc >= 0)
+    triplets->emplace_back(row, fc, 1.0);
+  if (lcol >= 0)
+    triplets->emplace_back(row, lcol, -coupling.multiplier * leaderScale / followerScale);
+}
+
 /// World twist of one unknown, positions in Lc: a point p moves by omega x p + v per unit of the unknown.
 struct Twist {
   Eigen::Vector3d omega = Eigen::Vector3d::Zero();
@@ -211,6 +250,9 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
         layout.length[j] = joint.length / lengthScale;
         rows = 1;
       }
+    } else if (joint.kind == ConnectionKind::Coupling) {
+      // Both ends are 1-DOF tree joints (the readers check it): one linear row in their unknowns.
+      rows = layout.unknownCount[joint.follower] == 1 && layout.unknownCount[joint.leader] == 1 ? 1 : 0;
     } else {
       rows = residualRows(joint.type);
     }
@@ -287,6 +329,11 @@ void evaluateClosure(const Mechanism& mechanism, const ClosureLayout& layout, co
   for (size_t c = 0; c < layout.constrained.size(); ++c) {
     const int j = layout.constrained[c];
     const Joint& joint = mechanism.joints[j];
+    if (joint.kind == ConnectionKind::Coupling) {
+      addCouplingRow(mechanism, layout, poses, joint, columns, layout.residualOffset[c], residual,
+                     jacobian != nullptr ? &triplets : nullptr);
+      continue;
+    }
     const Ends ends = endsOf(joint, poses, layout.lengthScale);
     const int offset = layout.residualOffset[c];
     const int count = layout.residualCount[c];
