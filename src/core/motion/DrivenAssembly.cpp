@@ -60,16 +60,20 @@ int numericalRank(const Eigen::MatrixXd& dense) {
   return rank;
 }
 
-/// Watches a conditioning indicator along the motion and reports its dips (local minima below a threshold).
+/// Watches a conditioning indicator along the motion and reports its dips: local minima below a tenth of its
+/// value at the start (so a model that is poorly conditioned everywhere, a long mast, reports nothing).
 struct DipWatch {
-  double previous = 2.0, beforePrevious = 2.0;
+  double start = -1.0, previous = -1.0, beforePrevious = -1.0;
   bool dipped(double current) {
-    const bool dip = previous < kThreshold && previous <= beforePrevious && previous < current;
+    if (start < 0.0)
+      start = current;
+    const bool dip = beforePrevious >= 0.0 && previous < kRelativeThreshold * start &&
+                     previous < beforePrevious && previous < current;
     beforePrevious = previous;
     previous = current;
     return dip;
   }
-  static constexpr double kThreshold = 0.05;
+  static constexpr double kRelativeThreshold = 0.1;
 };
 
 }  // namespace
