@@ -17,3 +17,6 @@
 #include "mobility_analysis/SparseElimination.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/UrdfLoader.hpp"
+#include "mobility_analysis/motion/DrivenAssembly.hpp"
+#include "mobility_analysis/motion/LoopClosure.hpp"
+#include "mobility_analysis/motion/TreeCoordinates.hpp"

@@ -169,6 +169,25 @@ TEST(DrivenAssembly, FollowingAMotionInSeveralCallsEndsWhereOneCallDoes) {
   EXPECT_NEAR(wrap(previous.at("j2") - valueOf(once).positions.at("j2")), 0.0, 1e-9);
 }
 
+TEST(DrivenAssembly, AnalysisFromThePreviousStateContinuesFromIt) {
+  // AnalysisOptions::startPoses is how the node follows a motion: from the state reached at j1 = 2 on to 2.5
+  // is where one run from the written pose to 2.5 ends.
+  const Mechanism mechanism = loadOrFail(motionFixture("crank_rocker.urdf"));
+  const MobilityAnalysis first = drive(motionFixture("crank_rocker.urdf"), {{"j1", 2.0}});
+  AnalysisOptions options;
+  options.positions = {{"j1", 2.5}};
+  options.startPoses = first.assembled.poses;
+  const Result<MobilityAnalysis> next = analyzeMechanism(mechanism, options);
+  ASSERT_TRUE(isOk(next)) << diagnosticOf(next).toString();
+  const MobilityAnalysis direct = drive(motionFixture("crank_rocker.urdf"), {{"j1", 2.5}});
+  for (size_t l = 0; l < mechanism.links.size(); ++l) {
+    EXPECT_TRUE(valueOf(next).assembled.poses[l].isApprox(direct.assembled.poses[l], 1e-9))
+        << mechanism.links[l].name;
+  }
+  EXPECT_LT(valueOf(next).report.assembly.steps,
+            direct.report.assembly.steps);  // it only went the last 0.5 rad
+}
+
 TEST(DrivenAssembly, DrakeFourBarWrittenStraightIsClosedThenDriven) {
   const Mechanism mechanism = loadOrFail(motionFixture("drake_four_bar2_straight.urdf"));
   const Result<DrivenMotion> moved =
