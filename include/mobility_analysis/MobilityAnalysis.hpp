@@ -16,7 +16,9 @@ namespace mobility_analysis {
 /// Options of one analysis.
 struct AnalysisOptions {
   AnalysisMode mode = AnalysisMode::Auto;
-  JointPositions positions;     ///< Driven tree-joint values; empty: the URDF pose (all tree joints at 0).
+  /// Driven tree-joint values [rad] or [m], held exactly; the other joints follow by continuation from the
+  /// start on its assembly mode (followDrivenPositions). Empty: the start pose, closed.
+  JointPositions positions;
   /// Where the assembly starts (the previous state when following a motion); empty: the written pose.
   std::optional<LinkPoses> startPoses;
   double rankTolerance = -1.0;  ///< Relative rank threshold; <= 0: tolerances::kRank.

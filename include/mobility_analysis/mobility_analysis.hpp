@@ -21,3 +21,6 @@
 #include "mobility_analysis/io/MjcfReader.hpp"
 #include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/io/UrdfReader.hpp"
+#include "mobility_analysis/motion/DrivenAssembly.hpp"
+#include "mobility_analysis/motion/LoopClosure.hpp"
+#include "mobility_analysis/motion/TreeCoordinates.hpp"

@@ -200,13 +200,16 @@ std::string toText(const MobilityReport& r) {
     out << "  positions reached [rad or m]:";
     for (size_t i = 0; i < r.positions.size() && i < kShown; ++i)
       out << (i ? ", " : " ") << r.positions[i].name << " " << number(r.positions[i].value, 9);
-    if (r.positions.size() > kShown) out << ", ... (" << r.positions.size() - kShown << " more in --json)";
+    if (r.positions.size() > kShown)
+      out << ", ... (" << r.positions.size() - kShown << " more in --json)";
     out << "\n";
   }
   out << "  assembly: residual " << number(r.assembly.residual, 3) << " m, " << r.assembly.steps
       << " continuation steps, " << r.assembly.iterations << " iterations; events: ";
-  if (r.assembly.events.empty()) out << "none";
-  for (size_t i = 0; i < r.assembly.events.size(); ++i) out << (i ? "; " : "") << r.assembly.events[i];
+  if (r.assembly.events.empty())
+    out << "none";
+  for (size_t i = 0; i < r.assembly.events.size(); ++i)
+    out << (i ? "; " : "") << r.assembly.events[i];
   out << "\n";
   return out.str();
 }

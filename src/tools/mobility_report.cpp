@@ -1,7 +1,7 @@
 /// mobility_report FILE [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1]
 /// [--rank-tolerance T] [--json] Prints the mobility report of a closed-loop URDF or an MJCF model, with the
-/// --positions joints held at their values; warnings go
-/// to stderr as "warning: ..." lines; on bad input one line on stderr and exit code 2.
+/// --positions joints held at their values; warnings go to stderr as "warning: ..." lines; on bad input one
+/// line on stderr and exit code 2.
 
 #include <chrono>
 #include <cstdlib>
@@ -26,8 +26,9 @@ const char* kUsage =
 
 /// --help: the usage line and what --positions does (errors print the usage line alone: one line).
 const char* kPositionsHelp =
-    "  --positions  hold these tree joints exactly at these values [rad or m]; the other joints follow by\n"
-    "               continuation from the written pose, in its assembly mode (exit 2 if a value is beyond reach)";
+    "  --positions  hold these tree joints exactly at these values [rad or m]; the other joints\n"
+    "               follow by continuation from the written pose, in its assembly mode\n"
+    "               (exit 2 if a value is beyond reach)";
 
 }  // namespace
 

@@ -169,6 +169,25 @@ TEST(DrivenAssembly, FollowingAMotionInSeveralCallsEndsWhereOneCallDoes) {
   EXPECT_NEAR(wrap(previous.at("j2") - valueOf(once).positions.at("j2")), 0.0, 1e-9);
 }
 
+TEST(DrivenAssembly, AnalysisFromThePreviousStateContinuesFromIt) {
+  // AnalysisOptions::startPoses is how the node follows a motion: from the state reached at j1 = 2 on to 2.5
+  // is where one run from the written pose to 2.5 ends.
+  const Mechanism mechanism = loadOrFail(motionFixture("crank_rocker.urdf"));
+  const MobilityAnalysis first = drive(motionFixture("crank_rocker.urdf"), {{"j1", 2.0}});
+  AnalysisOptions options;
+  options.positions = {{"j1", 2.5}};
+  options.startPoses = first.assembled.poses;
+  const Result<MobilityAnalysis> next = analyzeMechanism(mechanism, options);
+  ASSERT_TRUE(isOk(next)) << diagnosticOf(next).toString();
+  const MobilityAnalysis direct = drive(motionFixture("crank_rocker.urdf"), {{"j1", 2.5}});
+  for (size_t l = 0; l < mechanism.links.size(); ++l) {
+    EXPECT_TRUE(valueOf(next).assembled.poses[l].isApprox(direct.assembled.poses[l], 1e-9))
+        << mechanism.links[l].name;
+  }
+  EXPECT_LT(valueOf(next).report.assembly.steps,
+            direct.report.assembly.steps);  // it only went the last 0.5 rad
+}
+
 TEST(DrivenAssembly, DrakeFourBarWrittenStraightIsClosedThenDriven) {
   const Mechanism mechanism = loadOrFail(motionFixture("drake_four_bar2_straight.urdf"));
   const Result<DrivenMotion> moved =
@@ -338,4 +357,20 @@ TEST(DrivenAssembly, ParallelogramCrossesItsBranchPointOnItsOwnBranchAndSaysSo) 
       << event;
   // A motion that stays away from it meets nothing.
   EXPECT_TRUE(drive(motionFixture("parallelogram.urdf"), {{"j1", 1.0}}).report.assembly.events.empty());
+}
+
+TEST(DrivenAssembly, HobermanRingTurnsAllItsUnitsAlike) {
+  // urdf/hoberman_ring.urdf: six congruent angulated units, one bar the ground, DOF 1. The ring keeps its
+  // six-fold symmetry as it opens (one freedom cannot break it), so every pin turns by the input angle, with
+  // the sign of its side. The predictor is exact on this motion: the whole way is a few steps.
+  for (const double kink : {0.1, -0.2}) {
+    const MobilityAnalysis a = drive(urdfPath("hoberman_ring.urdf"), {{"kink_0", kink}});
+    EXPECT_EQ(reported(a.report, "kink_0"), kink);
+    for (int j = 0; j < 5; ++j) {
+      EXPECT_NEAR(reported(a.report, "pin_ab_" + std::to_string(j)), kink, 1e-9) << j;
+      EXPECT_NEAR(reported(a.report, "pin_ba_" + std::to_string(j)), -kink, 1e-9) << j;
+    }
+    EXPECT_EQ(a.report.dof, 1);
+    EXPECT_LE(a.report.assembly.residual, 1e-12 * a.report.characteristicLength);
+  }
 }

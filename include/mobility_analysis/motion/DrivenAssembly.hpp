@@ -21,7 +21,7 @@ struct DrivenMotionSettings {
   JointPositions reference;
   /// Look for branch and dead points (singular values of the Jacobian at every step); only for models with
   /// at most this many tree unknowns (0: never).
-  int eventSearchLimit = 300;
+  int eventSearchLimit = 120;
 };
 
 /// Where a driven motion ended up.

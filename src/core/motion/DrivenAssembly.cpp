@@ -44,7 +44,7 @@ std::string unitOf(const Joint& joint) {
 double conditionIndicator(const Eigen::MatrixXd& dense, int rank) {
   if (rank <= 0 || dense.size() == 0)
     return 1.0;
-  const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(dense).singularValues();
+  const Eigen::VectorXd sigma = Eigen::BDCSVD<Eigen::MatrixXd>(dense).singularValues();
   if (sigma.size() < rank || sigma(0) <= 0.0)
     return 1.0;
   return sigma(rank - 1) / sigma(0);
@@ -53,23 +53,27 @@ double conditionIndicator(const Eigen::MatrixXd& dense, int rank) {
 int numericalRank(const Eigen::MatrixXd& dense) {
   if (dense.size() == 0)
     return 0;
-  const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(dense).singularValues();
+  const Eigen::VectorXd sigma = Eigen::BDCSVD<Eigen::MatrixXd>(dense).singularValues();
   int rank = 0;
   for (int i = 0; i < sigma.size(); ++i)
     rank += sigma(i) > 1e-8 * sigma(0) ? 1 : 0;
   return rank;
 }
 
-/// Watches a conditioning indicator along the motion and reports its dips (local minima below a threshold).
+/// Watches a conditioning indicator along the motion and reports its dips: local minima below a tenth of its
+/// value at the start (so a model that is poorly conditioned everywhere, a long mast, reports nothing).
 struct DipWatch {
-  double previous = 2.0, beforePrevious = 2.0;
+  double start = -1.0, previous = -1.0, beforePrevious = -1.0;
   bool dipped(double current) {
-    const bool dip = previous < kThreshold && previous <= beforePrevious && previous < current;
+    if (start < 0.0)
+      start = current;
+    const bool dip = beforePrevious >= 0.0 && previous < kRelativeThreshold * start &&
+                     previous < beforePrevious && previous < current;
     beforePrevious = previous;
     previous = current;
     return dip;
   }
-  static constexpr double kThreshold = 0.05;
+  static constexpr double kRelativeThreshold = 0.1;
 };
 
 }  // namespace
@@ -185,6 +189,8 @@ Result<DrivenMotion> followDrivenPositions(const Mechanism& mechanism, const Lin
   int attempts = 0;
   while (s < 1.0 && span > 0.0) {
     h = std::min(h, 1.0 - s);
+    if (1.0 - s - h < 0.25 * h)
+      h = 1.0 - s;  // no sliver of a last step (it could fall below hMin)
     // Predictor: the least-change motion of the free joints that keeps the loops closed to first order.
     evaluateClosure(mechanism, layout, poses, all, numAll, residual, &jacobian);
     const Eigen::VectorXd drive = jacobian * rate;
@@ -198,7 +204,7 @@ Result<DrivenMotion> followDrivenPositions(const Mechanism& mechanism, const Lin
       h = std::max(maxStep / freeSpeed, hMin * 0.5);
     bool accepted = false;
     while (!accepted) {
-      if (h < hMin || ++attempts > kMaxAttempts) {
+      if ((h < hMin && h < 1.0 - s) || ++attempts > kMaxAttempts) {
         // The target lies beyond a dead point of this assembly mode (or the drivers contradict each other).
         const Driver* worst = &drivers.front();
         for (const Driver& d : drivers)

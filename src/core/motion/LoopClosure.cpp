@@ -80,7 +80,7 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
       for (int k = 0; k < J.outerSize(); ++k)
         for (Eigen::SparseMatrix<double>::InnerIterator it(J, k); it; ++it)
           largest = std::max(largest, std::abs(it.value()));
-      mu = 1e-6 * std::max(largest * largest, 1e-12);
+      mu = 1e-10 * std::max(largest * largest, 1e-12);
     }
     ++result.iterations;
     if (!solveDampedLeastSquares(J, r, mu, step)) {
