@@ -70,7 +70,7 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
   }
   configured_ = true;
   markerPublisher_ = privateNodeHandle_.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
-  jointStatePublisher_ = nodeHandle_.advertise<sensor_msgs::JointState>("joint_states", 10, true);
+  jointStatePublisher_ = nodeHandle_.advertise<sensor_msgs::JointState>("joint_states", 100, true);
   tfStaticPublisher_ = nodeHandle_.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
   descriptionPublisher_ = privateNodeHandle_.advertise<std_msgs::String>("robot_description", 1, true);
 

@@ -238,6 +238,7 @@ TEST(MobilityMotion, moveSweepsTheBennettWithItsLoopClosed) {
   move.request.start = 0.0;
   move.request.end = 2.0 * M_PI;
   move.request.steps = 61;
+  move.request.duration = 3.0;  // 20 states a second: none dropped on the way
   ASSERT_TRUE(ros::service::call("/bennett/mobility_server/move", move));
   ASSERT_TRUE(move.response.success) << move.response.message;
   EXPECT_EQ(move.response.driveable_joints, std::vector<std::string>{"j1"}) << "DOF 1, the first tree joint";
