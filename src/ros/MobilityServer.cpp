@@ -70,7 +70,7 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
   }
   configured_ = true;
   markerPublisher_ = privateNodeHandle_.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
-  jointStatePublisher_ = nodeHandle_.advertise<sensor_msgs::JointState>("joint_states", 10, true);
+  jointStatePublisher_ = nodeHandle_.advertise<sensor_msgs::JointState>("joint_states", 100, true);
   tfStaticPublisher_ = nodeHandle_.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
   descriptionPublisher_ = privateNodeHandle_.advertise<std_msgs::String>("robot_description", 1, true);
 
@@ -171,7 +171,8 @@ bool MobilityServer::readParameters() {
   }
 
   if (privateNodeHandle_.hasParam("closures")) {
-    // TODO(readers): read the closure file through readMechanismFromString once the readers' front door is in.
+    // TODO(readers): read the closure file through readMechanismFromString once the readers' front door is
+    // in.
     ROS_FATAL("Parameter '%s' is not supported by this build (the closure-file reader is not in it)",
               privateNodeHandle_.resolveName("closures").c_str());
     return false;
@@ -368,6 +369,7 @@ bool MobilityServer::loadRobot(LoadRobot::Request& request, LoadRobot::Response&
     }
     const double analysed = secondsSince(start);
     std::shared_ptr<State> state = valueOf(std::move(loaded));
+    double described = 0.0;
     {
       // Swap in: the state loop finishes the step it is in (its result, of the old model, is then dropped).
       std::lock_guard<std::mutex> motion(motionMutex_);
@@ -378,16 +380,18 @@ bool MobilityServer::loadRobot(LoadRobot::Request& request, LoadRobot::Response&
         loadError_.clear();
       }
       unreachableLogged_ = false;
+      const auto setting = std::chrono::steady_clock::now();
       nodeHandle_.setParam("robot_description", state->description);
+      described = secondsSince(setting);
       publish(*state, ros::Time::now(), true);
     }
     toResponse(state->analysis.report, response);
     const MobilityReport& r = state->analysis.report;
     ROS_INFO(
         "load_robot: now serving '%s' (%s): DOF %d, Grubler %d, %d redundant equations (read and analysed in "
-        "%.3f s, served in %.3f s)",
+        "%.3f s, served in %.3f s of which robot_description %.3f s)",
         r.robot.c_str(), r.mode.c_str(), r.dof, r.grublerKutzbachDof, r.numRedundant, analysed,
-        secondsSince(start));
+        secondsSince(start), described);
   });
 }
 

@@ -22,6 +22,10 @@ constexpr double kTextHeight = 0.07;
 constexpr double kTitleHeight = 0.1;
 /// A link with more joint points than this is drawn as a star from its centroid, not as all pairs.
 constexpr size_t kMaxPlateCorners = 6;
+/// A label that meets others moves at most this many lines down (then stays: the search stays linear).
+constexpr int kMaxLabelShifts = 4;
+/// Labels remembered per grid cell of the overlap search (more pile up unchecked: the search stays linear).
+constexpr size_t kMaxLabelsPerCell = 16;
 /// Two joint points closer than this fraction of the characteristic length are one point [-].
 constexpr double kSamePoint = 1e-6;
 
@@ -584,9 +588,11 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   for (Marker& m : labels) {
     Eigen::Vector3d at(m.pose.position.x, m.pose.position.y, m.pose.position.z);
     const double width = halfWidth(m.text);
-    for (int i = 0; i < 1000 && !isFree(at, width); ++i)
+    for (int i = 0; i < kMaxLabelShifts && !isFree(at, width); ++i)
       at -= 1.2 * line * up;
-    taken[cellOf(at)].push_back(Placed{at, width});
+    std::vector<Placed>& cell = taken[cellOf(at)];
+    if (cell.size() < kMaxLabelsPerCell)
+      cell.push_back(Placed{at, width});  // A pile beyond: checks stay bounded.
     m.pose.position = toPoint(at);
     top = std::max(top, at.dot(up));
   }

