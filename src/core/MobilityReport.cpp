@@ -182,6 +182,10 @@ std::string toText(const MobilityReport& r) {
   out << "  Grubler-Kutzbach count:                                  " << r.grublerKutzbachDof << "\n";
   out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints << ", rank "
       << r.rank << "\n";
+  out << "  Calladine-Maxwell: m = num_coordinates - rank = " << r.numCoordinates << " - " << r.rank << " = "
+      << r.selfStress.mechanismModes << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints
+      << " - " << r.rank << " = " << r.selfStress.count << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
+      << " = num_coordinates - num_constraints\n";
   out << "  redundant equations: " << r.numRedundant << " (= dof - Grubler = " << r.dof - r.grublerKutzbachDof
       << ")\n";
   for (const RedundantJoint& j : r.redundantJoints) {
@@ -222,10 +226,6 @@ std::string toText(const MobilityReport& r) {
     out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length " << number(d.initialLength, 6)
         << " m -> " << number(d.finalLength, 9) << " m, final DOF " << d.finalDof << "; " << d.reason << "\n";
   }
-  out << "  Calladine-Maxwell: m = num_coordinates - rank = " << r.numCoordinates << " - " << r.rank << " = "
-      << r.selfStress.mechanismModes << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints
-      << " - " << r.rank << " = " << r.selfStress.count << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
-      << " = num_coordinates - num_constraints\n";
   const SelfStressInfo& s = r.selfStress;
   for (size_t k = 0; k < s.states.size() && k < 20; ++k) {
     out << "    state " << k + 1 << ":";

@@ -47,6 +47,14 @@ Mechanism lockActiveCables(const Mechanism& mechanism, const LinkPoses& poses, s
 /// @return Rows of the distance equations of the taut cables in @p model (passive taut and locked active).
 std::vector<int> findTautCableRows(const Mechanism& mechanism, const CoordinateModel& model);
 
+/**
+ * @brief The basis' states as multipliers of the equations as written: SelfStressBasis eliminates rows scaled
+ * to unit norm, so its coefficient of row r is y_r |J_r|; this divides it out (y^T J = 0 then holds for J
+ * itself) and rescales each state to unit largest coefficient.
+ */
+std::vector<SelfStress> toEquilibriumStresses(const std::vector<SelfStress>& stresses,
+                                              const SparseJacobian& J);
+
 /// @return The state @p stress as a dense multiplier vector (dim @p numConstraints).
 Eigen::VectorXd toMultipliers(const SelfStress& stress, int numConstraints);
 

@@ -117,6 +117,28 @@ Mechanism lockActiveCables(const Mechanism& mechanism, const LinkPoses& poses, s
   return copy;
 }
 
+std::vector<SelfStress> toEquilibriumStresses(const std::vector<SelfStress>& stresses,
+                                              const SparseJacobian& J) {
+  std::vector<SelfStress> result;
+  result.reserve(stresses.size());
+  for (const SelfStress& stress : stresses) {
+    SelfStress scaled;
+    scaled.reserve(stress.size());
+    double largest = 0.0;
+    for (const auto& [row, value] : stress) {
+      const double norm = J.row(row).norm();
+      if (norm <= 0.0)
+        continue;
+      scaled.emplace_back(row, value / norm);
+      largest = std::max(largest, std::abs(value / norm));
+    }
+    for (auto& entry : scaled)
+      entry.second /= largest > 0.0 ? largest : 1.0;
+    result.push_back(std::move(scaled));
+  }
+  return result;
+}
+
 Eigen::VectorXd toMultipliers(const SelfStress& stress, int numConstraints) {
   Eigen::VectorXd y = Eigen::VectorXd::Zero(numConstraints);
   for (const auto& [row, value] : stress)
@@ -130,10 +152,11 @@ SelfStressInfo computeSelfStressInfo(const Mechanism& mechanism, const Coordinat
   SelfStressInfo info;
   info.count = basis.numConstraints - basis.rank;
   info.mechanismModes = basis.numCoordinates - basis.rank;
-  info.statesListed = basis.stresses.size() <= kMaxListedStates;
+  const std::vector<SelfStress> stresses = toEquilibriumStresses(basis.stresses, J);
+  info.statesListed = stresses.size() <= kMaxListedStates;
   if (info.statesListed) {
-    info.states.reserve(basis.stresses.size());
-    for (const SelfStress& stress : basis.stresses)
+    info.states.reserve(stresses.size());
+    for (const SelfStress& stress : stresses)
       info.states.push_back(SelfStressState{elementForces(mechanism, model, stress)});
   }
 
@@ -143,12 +166,11 @@ SelfStressInfo computeSelfStressInfo(const Mechanism& mechanism, const Coordinat
     info.stability = "no taut cables to prestress";
     return info;
   }
-  const CablePrestress prestress = findCablePrestress(basis.stresses, model.numConstraints(), cableRows);
+  const CablePrestress prestress = findCablePrestress(stresses, model.numConstraints(), cableRows);
   info.prestressable = prestress.feasible;
   if (!prestress.feasible) {
-    info.stability = basis.stresses.empty()
-                         ? "no state of self-stress: the taut cables cannot be pretensioned"
-                         : "no combination of the states tensions every taut cable";
+    info.stability = stresses.empty() ? "no state of self-stress: the taut cables cannot be pretensioned"
+                                      : "no combination of the states tensions every taut cable";
     return info;
   }
   std::vector<std::pair<int, double>> entries;
