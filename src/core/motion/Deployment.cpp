@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 #include <Eigen/SparseCholesky>
@@ -10,21 +11,24 @@
 #include "mobility_analysis/Assembly.hpp"
 #include "mobility_analysis/ConstraintJacobian.hpp"
 #include "mobility_analysis/Kinematics.hpp"
+#include "mobility_analysis/SelfStressBasis.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
 
 namespace {
 
-/// Newton converged when max |Phi| is below this [Lc].
-constexpr double kStepClosure = 1e-11;
+/// Newton converged when max |Phi| is below this [Lc] (the assembly's closure).
+constexpr double kStepClosure = tolerances::kClosure;
 constexpr int kStepIterations = 30;
 /// A located crossing leaves every passive cable's relative gap in [0, kCrossingGap].
 constexpr double kCrossingGap = 1e-9;
 /// A step that does not converge is halved at most this many times before the deployment stops.
 constexpr int kMaxHalvings = 10;
-/// A pivot of the damped normal matrix J J^T below this fraction of the largest marks a dependent row.
-constexpr double kDependentPivot = 1e-9;
+/// Models up to this many coordinates get their DOF computed at every step.
+constexpr int kDofEveryStepCoordinates = 5000;
+/// Larger models: about this many steps get their DOF computed.
+constexpr int kDofSamples = 20;
 /// Added to the diagonal of J J^T [Lc^2]: keeps it factorable when rows are (consistently) dependent.
 constexpr double kDamping = 1e-13;
 
@@ -42,32 +46,39 @@ struct DrivenModel {
 };
 
 /// Newton from @p q to Phi(q) = 0 with minimum-norm steps (a tiny damping makes consistent redundant
-/// equations harmless) and backtracking when a step would more than double |Phi|; @p dependentRows receives
-/// the dependent rows of J at the solution.
-bool solve(const CoordinateModel& model, Eigen::VectorXd& q, int& dependentRows) {
+/// equations harmless) and backtracking when a step would more than double |Phi|.
+bool solve(const CoordinateModel& model, Eigen::VectorXd& q) {
   Eigen::VectorXd phi;
   computeConstraintResidual(model, q, phi);
   for (int iteration = 0; iteration <= kStepIterations; ++iteration) {
-    const SparseJacobian J = computeConstraintJacobian(model, q);
+    // Rows scaled to unit norm: the same Newton step (the solution set of J dq = -Phi is unchanged), but the
+    // driving row of a long mast, whose length moves a thousand bars, no longer dwarfs J J^T's conditioning.
+    const SparseJacobian raw = computeConstraintJacobian(model, q);
+    Eigen::VectorXd rowScale(raw.rows());
+    for (int r = 0; r < raw.rows(); ++r) {
+      const double norm = raw.row(r).norm();
+      rowScale(r) = norm > 0.0 ? 1.0 / norm : 1.0;
+    }
+    const SparseJacobian J = rowScale.asDiagonal() * raw;
     const Eigen::SparseMatrix<double> jt = J.transpose();
-    Eigen::SparseMatrix<double> normal = (J * jt).eval();
-    for (int i = 0; i < normal.rows(); ++i)
-      normal.coeffRef(i, i) += kDamping;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
+    const Eigen::SparseMatrix<double> normal = (J * jt).eval();
+    Eigen::SparseMatrix<double> damped = normal;
+    for (int i = 0; i < damped.rows(); ++i)
+      damped.coeffRef(i, i) += kDamping;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(damped);
     if (ldlt.info() != Eigen::Success)
       return false;
     if (maxAbs(phi) <= kStepClosure) {
-      // The rank at the solution, from the pivots of the (barely damped) normal matrix.
-      const Eigen::VectorXd d = ldlt.vectorD();
-      const double largest = d.size() ? d.cwiseAbs().maxCoeff() : 0.0;
-      dependentRows = 0;
-      for (int i = 0; i < d.size(); ++i)
-        dependentRows += std::abs(d(i)) <= kDependentPivot * largest ? 1 : 0;
       return true;
     }
     if (iteration == kStepIterations)
       break;
-    const Eigen::VectorXd step = jt * ldlt.solve(phi);
+    // Minimum-norm step J^T (J J^T)^-1 Phi, refined against the undamped J J^T.
+    const Eigen::VectorXd scaledPhi = rowScale.cwiseProduct(phi);
+    Eigen::VectorXd multipliers = ldlt.solve(scaledPhi);
+    for (int refinement = 0; refinement < 2; ++refinement)
+      multipliers += ldlt.solve((scaledPhi - normal * multipliers).eval());
+    const Eigen::VectorXd step = jt * multipliers;
     const double norm = phi.norm();
     bool accepted = false;
     for (double alpha = 1.0; alpha > 1e-3 && !accepted; alpha *= 0.5) {
@@ -148,11 +159,23 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
   info.targetLength = options.targetLength ? *options.targetLength : 0.0;
   JointPositions previousPositions = computeJointPositions(mechanism, poses, start.positions);
 
-  auto record = [&](double length, int dependentRows) {
+  // DOF per step: the rank of J without the driving row, by the same sweep as the report (every step on
+  // small models, else at about kDofSamples evenly spaced steps, the others carrying the last value).
+  const int dofEvery =
+      dm.model.numCoordinates() <= kDofEveryStepCoordinates ? 1 : std::max(1, options.steps / kDofSamples);
+  int lastDof = -1;
+  auto dofAt = [&](const Eigen::VectorXd& coordinates) {
+    SparseJacobian J = computeConstraintJacobian(dm.model, coordinates);
+    J.row(dm.driverRow) *= 0.0;
+    const double tolerance = start.rankTolerance > 0.0 ? start.rankTolerance : tolerances::kRank;
+    const SelfStressBasis basis = computeSelfStressBasis(driven, dm.model, J, tolerance);
+    return basis.numCoordinates - basis.rank;
+  };
+  auto record = [&](double length, bool final) {
     DeploymentStep step;
     step.activeLength = length;
-    // Nullity without the driving equation (independent while the continuation is regular).
-    step.dof = dm.model.numCoordinates() - (dm.model.numConstraints() - dependentRows) + 1;
+    const bool due = lastDof < 0 || final || info.steps.size() % static_cast<size_t>(dofEvery) == 0;
+    step.dof = due ? (lastDof = dofAt(q)) : lastDof;
     for (size_t j = 0; j < mechanism.joints.size(); ++j) {
       const Joint& joint = mechanism.joints[j];
       if (joint.kind != ConnectionKind::Cable)
@@ -179,11 +202,10 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
   };
 
   dm.setLength(info.initialLength);
-  int dependent = 0;
-  if (!solve(dm.model, q, dependent))
+  if (!solve(dm.model, q))
     return makeDiagnostic(mechanism.file, "cable", options.cable,
                           "the start pose does not close with the cable");
-  record(info.initialLength, dependent);
+  record(info.initialLength, false);
 
   double length = info.initialLength;
   Eigen::VectorXd previousQ = q;
@@ -192,20 +214,20 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
   info.reason = "reached the target length without a passive cable going taut";
   // Solves at length L from the state (qa, La), predicting along the secant through (qb, Lb).
   auto solveAt = [&](double target, const Eigen::VectorXd& qa, double la, const Eigen::VectorXd& qb,
-                     double lb, Eigen::VectorXd& out, int& dependentRows) {
+                     double lb, Eigen::VectorXd& out) {
     out = lb != la ? (qa + (qb - qa) * ((target - la) / (lb - la))).eval() : qa;
     dm.setLength(target);
-    return solve(dm.model, out, dependentRows);
+    return solve(dm.model, out);
   };
   bool stopped = false;
   for (int k = 1; k <= options.steps && !stopped; ++k) {
     const double targetK = info.initialLength + step * k;
     Eigen::VectorXd next;
     double reached = targetK;
-    bool ok = solveAt(targetK, q, length, previousQ, previousLength, next, dependent);
+    bool ok = solveAt(targetK, q, length, previousQ, previousLength, next);
     for (int halving = 0; !ok && halving < kMaxHalvings; ++halving) {
       reached = 0.5 * (length + reached);
-      ok = solveAt(reached, q, length, previousQ, previousLength, next, dependent);
+      ok = solveAt(reached, q, length, previousQ, previousLength, next);
     }
     if (!ok || reached != targetK) {
       if (ok) {
@@ -219,7 +241,7 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
                     length);
       info.reason = what;
       if (ok)
-        record(length, dependent);
+        record(length, true);
       break;
     }
     LinkPoses nextPoses = recoverPoses(dm.model, next, poses);
@@ -231,7 +253,7 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
       length = targetK;
       poses = std::move(nextPoses);
       stopped = gap <= kCrossingGap;
-      record(length, dependent);
+      record(length, stopped || k == options.steps);
       continue;
     }
     // A passive cable went taut inside (length, targetK]: regula falsi (Illinois) on the smallest gap.
@@ -244,13 +266,12 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
       if (!(lm > std::min(la, lb) && lm < std::max(la, lb)))
         lm = 0.5 * (la + lb);
       Eigen::VectorXd qm;
-      int dependentM = 0;
-      if (!solveAt(lm, qa, la, qb, lb, qm, dependentM))
+      if (!solveAt(lm, qa, la, qb, lb, qm))
         break;
       const LinkPoses posesM = recoverPoses(dm.model, qm, poses);
       const double gm = smallestGap(mechanism, posesM);
       if (gm >= 0.0) {
-        la = lm, ga = gm, qa = qm, dependent = dependentM;
+        la = lm, ga = gm, qa = qm;
         if (side == -1)
           gb *= 0.5;
         side = -1;
@@ -269,7 +290,7 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
     length = la;
     poses = recoverPoses(dm.model, q, poses);
     stopped = true;
-    record(length, dependent);
+    record(length, true);
   }
   if (stopped) {
     for (const Joint& joint : mechanism.joints) {
