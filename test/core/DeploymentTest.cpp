@@ -1,8 +1,14 @@
 /// Deployment by an active cable: the SLE mast and the ring pantograph stop exactly where their passive
 /// cables go taut, checked against the closed forms of their geometry.
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
@@ -143,4 +149,62 @@ TEST(Deployment, JsonReportsTheSteps) {
             std::string::npos);
   EXPECT_NE(json.find("\"final_length\": 0.707106781"), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
+}
+
+namespace {
+
+struct CliRun {
+  int status;
+  std::string out, err;
+};
+
+CliRun runReport(const std::string& arguments) {
+  const std::string errFile = ::testing::TempDir() + "deployment_cli_stderr.txt";
+  const std::string command = std::string(MA_REPORT_EXE) + " " + arguments + " 2>" + errFile;
+  CliRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.out.append(buffer.data(), n);
+  run.status = WEXITSTATUS(pclose(pipe));
+  std::ifstream err(errFile);
+  std::stringstream text;
+  text << err.rdbuf();
+  run.err = text.str();
+  return run;
+}
+
+}  // namespace
+
+TEST(DeploymentCli, DeployAndLockFlags) {
+  const CliRun deploy =
+      runReport(urdfPath("sle_deployable_folded.urdf") + " --deploy active_base --steps 20 --json");
+  EXPECT_EQ(deploy.status, 0) << deploy.err;
+  EXPECT_NE(deploy.out.find("\"final_dof\": 0"), std::string::npos);
+  EXPECT_NE(deploy.out.find("\"stopped_by\": [\"passive_1\""), std::string::npos);
+  const CliRun lock = runReport(urdfPath("sle_deployable_deployed.urdf") + " --lock-active-cables --json");
+  EXPECT_EQ(lock.status, 0) << lock.err;
+  EXPECT_NE(lock.out.find("\"self_stress\": {\"count\": 4"), std::string::npos);
+  EXPECT_NE(lock.out.find("\"prestressable\": true"), std::string::npos);
+  EXPECT_NE(lock.out.find("\"state\": \"locked\""), std::string::npos);
+}
+
+TEST(DeploymentCli, BadDeploymentArgumentsExitTwoWithOneLine) {
+  const std::string mast = urdfPath("sle_deployable_folded.urdf");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {mast + " --deploy passive_1", "passive_1"},
+      {mast + " --deploy nope", "nope"},
+      {mast + " --deploy active_base --steps 0", "--steps"},
+      {mast + " --deploy active_base --deploy-to -1", "--deploy-to"},
+      {mast + " --deploy active_base --lock-active-cables", "--lock-active-cables"},
+      {mast + " --deploy", "--deploy"},
+  };
+  for (const auto& [arguments, name] : cases) {
+    const CliRun run = runReport(arguments);
+    EXPECT_EQ(run.status, 2) << arguments;
+    EXPECT_TRUE(run.out.empty()) << arguments;
+    EXPECT_NE(run.err.find(name), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
 }
