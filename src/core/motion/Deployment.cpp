@@ -308,7 +308,10 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
   AnalysisOptions finalOptions = start;
   finalOptions.positions.clear();
   finalOptions.startPoses = poses;
-  Result<MobilityAnalysis> analysis = analyzeMechanism(mechanism, finalOptions);
+  // The final report shows the active cable at the length it was shortened to.
+  Mechanism deployed = mechanism;
+  deployed.joints[cable].length = length;
+  Result<MobilityAnalysis> analysis = analyzeMechanism(deployed, finalOptions);
   if (!isOk(analysis))
     return analysis;
   MobilityAnalysis result = valueOf(std::move(analysis));
