@@ -18,7 +18,9 @@ namespace mobility_analysis {
 
 namespace {
 
-/// Newton converged when max |Phi| is below this [Lc] (the assembly's closure).
+/// Newton converged when max |Phi| is below this [Lc] (the assembly's closure). On a 1000-unit mast J is so
+/// ill-conditioned that Newton gets no further, and the stop is then located to ~3e-7 relative (within the
+/// cables' taut tolerance tolerances::kCableTaut); small models land within 1e-12.
 constexpr double kStepClosure = tolerances::kClosure;
 constexpr int kStepIterations = 30;
 /// A located crossing leaves every passive cable's relative gap in [0, kCrossingGap].
@@ -47,10 +49,18 @@ struct DrivenModel {
 
 /// Newton from @p q to Phi(q) = 0 with minimum-norm steps (a tiny damping makes consistent redundant
 /// equations harmless) and backtracking when a step would more than double |Phi|.
-bool solve(const CoordinateModel& model, Eigen::VectorXd& q) {
+/// The factorisation of J J^T, whose pattern is the same at every step: ordered once, refactored per iteration.
+struct NewtonWorkspace {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  Eigen::Index analysedNonZeros = -1;
+};
+
+bool solve(const CoordinateModel& model, Eigen::VectorXd& q, NewtonWorkspace& workspace) {
   Eigen::VectorXd phi;
   computeConstraintResidual(model, q, phi);
-  for (int iteration = 0; iteration <= kStepIterations; ++iteration) {
+  for (int iteration = 0; iteration < kStepIterations; ++iteration) {
+    if (maxAbs(phi) <= kStepClosure)
+      return true;
     // Rows scaled to unit norm: the same Newton step (the solution set of J dq = -Phi is unchanged), but the
     // driving row of a long mast, whose length moves a thousand bars, no longer dwarfs J J^T's conditioning.
     const SparseJacobian raw = computeConstraintJacobian(model, q);
@@ -65,14 +75,14 @@ bool solve(const CoordinateModel& model, Eigen::VectorXd& q) {
     Eigen::SparseMatrix<double> damped = normal;
     for (int i = 0; i < damped.rows(); ++i)
       damped.coeffRef(i, i) += kDamping;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(damped);
+    if (damped.nonZeros() != workspace.analysedNonZeros) {
+      workspace.ldlt.analyzePattern(damped);
+      workspace.analysedNonZeros = damped.nonZeros();
+    }
+    workspace.ldlt.factorize(damped);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& ldlt = workspace.ldlt;
     if (ldlt.info() != Eigen::Success)
       return false;
-    if (maxAbs(phi) <= kStepClosure) {
-      return true;
-    }
-    if (iteration == kStepIterations)
-      break;
     // Minimum-norm step J^T (J J^T)^-1 Phi, refined against the undamped J J^T.
     const Eigen::VectorXd scaledPhi = rowScale.cwiseProduct(phi);
     Eigen::VectorXd multipliers = ldlt.solve(scaledPhi);
@@ -94,7 +104,7 @@ bool solve(const CoordinateModel& model, Eigen::VectorXd& q) {
     if (!accepted)
       return false;
   }
-  return false;
+  return maxAbs(phi) <= kStepClosure;
 }
 
 double cableDistance(const Joint& joint, const LinkPoses& poses) {
@@ -202,7 +212,8 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
   };
 
   dm.setLength(info.initialLength);
-  if (!solve(dm.model, q))
+  NewtonWorkspace workspace;
+  if (!solve(dm.model, q, workspace))
     return makeDiagnostic(mechanism.file, "cable", options.cable,
                           "the start pose does not close with the cable");
   record(info.initialLength, false);
@@ -217,7 +228,7 @@ Result<MobilityAnalysis> deployMechanism(const Mechanism& mechanism, const Deplo
                      double lb, Eigen::VectorXd& out) {
     out = lb != la ? (qa + (qb - qa) * ((target - la) / (lb - la))).eval() : qa;
     dm.setLength(target);
-    return solve(dm.model, out);
+    return solve(dm.model, out, workspace);
   };
   bool stopped = false;
   for (int k = 1; k <= options.steps && !stopped; ++k) {
