@@ -59,7 +59,7 @@ CablePrestress findCablePrestress(const std::vector<SelfStress>& states, int num
   lp.loadProblem(matrix, columnLower.data(), columnUpper.data(), objective.data(), rowLower.data(),
                  rowUpper.data());
   lp.setOptimizationDirection(-1.0);  // maximise t
-  lp.dual();
+  lp.initialSolve();  // presolve, then the method Clp picks
   if (!lp.isProvenOptimal())
     return result;
   const double* solution = lp.getColSolution();
