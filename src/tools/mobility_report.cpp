@@ -131,8 +131,6 @@ int main(int argc, char** argv) {
       }
     };
     options.lockActiveCables = lockActiveCables;
-    if (!deployCable.empty() && lockActiveCables)
-      return fail("mobility_report: --deploy drives an active cable; it cannot be combined with --lock-active-cables");
     DeploymentOptions deployment;
     deployment.cable = deployCable;
     deployment.steps = deploySteps;

@@ -188,6 +188,13 @@ TEST(DeploymentCli, DeployAndLockFlags) {
   EXPECT_NE(lock.out.find("\"self_stress\": {\"count\": 4"), std::string::npos);
   EXPECT_NE(lock.out.find("\"prestressable\": true"), std::string::npos);
   EXPECT_NE(lock.out.find("\"state\": \"locked\""), std::string::npos);
+  // Deployed, then the actuator locked: the final report is the prestressable structure.
+  const CliRun both = runReport(urdfPath("sle_deployable_folded.urdf") +
+                                " --deploy active_base --steps 20 --lock-active-cables --json");
+  EXPECT_EQ(both.status, 0) << both.err;
+  EXPECT_NE(both.out.find("\"self_stress\": {\"count\": 4"), std::string::npos);
+  EXPECT_NE(both.out.find("\"prestressable\": true"), std::string::npos);
+  EXPECT_NE(both.out.find("\"final_dof\": 0"), std::string::npos);
 }
 
 TEST(DeploymentCli, BadDeploymentArgumentsExitTwoWithOneLine) {
@@ -197,7 +204,6 @@ TEST(DeploymentCli, BadDeploymentArgumentsExitTwoWithOneLine) {
       {mast + " --deploy nope", "nope"},
       {mast + " --deploy active_base --steps 0", "--steps"},
       {mast + " --deploy active_base --deploy-to -1", "--deploy-to"},
-      {mast + " --deploy active_base --lock-active-cables", "--lock-active-cables"},
       {mast + " --deploy", "--deploy"},
   };
   for (const auto& [arguments, name] : cases) {

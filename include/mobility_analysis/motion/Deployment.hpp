@@ -16,9 +16,11 @@ struct DeploymentOptions {
   std::string cable;  ///< The active cable that drives (it is shortened).
   int steps = 100;    ///< Equal steps from its current length to targetLength.
   std::optional<double>
-      targetLength;          ///< [m]; empty: 0 (the continuation stops earlier, when a cable goes taut).
-  int recordedJoints = 4;    ///< Tree joints whose values each step records (first in document order).
-  AnalysisOptions analysis;  ///< Mode, tolerance, start pose (positions / startPoses) of the start.
+      targetLength;        ///< [m]; empty: 0 (the continuation stops earlier, when a cable goes taut).
+  int recordedJoints = 4;  ///< Tree joints whose values each step records (first in document order).
+  /// Mode, tolerance, start pose (positions / startPoses). With lockActiveCables the final report locks the
+  /// active cables at their final lengths (the lecture: "at the end of deployment the actuator is locked").
+  AnalysisOptions analysis;
   /// Called after each step with the step and the link poses there (the node animates with it); may be empty.
   std::function<void(const DeploymentStep&, const LinkPoses&)> onStep;
 };
