@@ -22,6 +22,9 @@ struct AnalysisOptions {
   /// Where the assembly starts (the previous state when following a motion); empty: the written pose.
   std::optional<LinkPoses> startPoses;
   double rankTolerance = -1.0;  ///< Relative rank threshold; <= 0: tolerances::kRank.
+  /// Analyse every active cable as locked: a taut cable of the length it has at the assembled pose (the
+  /// deployed mast with its actuator locked), instead of ignoring it as the driver.
+  bool lockActiveCables = false;
   /// Called with a phase name and a fraction in [0, 1] during long analyses; may be empty.
   std::function<void(const std::string&, double)> progress;
 };

@@ -78,6 +78,57 @@ struct AssemblyInfo {
   std::vector<std::string> events;  ///< Branch points or dead points met, one readable line each.
 };
 
+/// One element's share of a state of self-stress (or of a prestress), relative to the largest.
+struct ElementForce {
+  std::string name;
+  std::string kind;    ///< "link", "joint", "loop_joint", "distance_constraint", "cable" or "boundary".
+  /// Relative force in [-1, 1]: cables and distance constraints signed (tension positive, the axial force
+  /// 2 y L of the equation |p2 - p1|^2 = L^2 with multiplier y); links, joints and boundaries the magnitude
+  /// (norm of their equations' multipliers), >= 0.
+  double force = 0.0;
+};
+
+/// One state of self-stress: the elements that carry it (its support).
+struct SelfStressState {
+  std::vector<ElementForce> elements;
+};
+
+/**
+ * @brief States of self-stress and prestress (Calladine–Maxwell: m = num_coordinates − rank is the dof,
+ * s = num_constraints − rank the count; Guest & Fowler 2005).
+ */
+struct SelfStressInfo {
+  int count = 0;                        ///< s = num_constraints − rank = number of redundant equations.
+  int mechanismModes = 0;               ///< m = num_coordinates − rank = dof.
+  std::vector<SelfStressState> states;  ///< On the local basis of SelfStressBasis (at most kMaxListedStates).
+  bool statesListed = true;             ///< False when count exceeded the listing limit.
+  int tautCables = 0;                   ///< Taut passive cables (and locked active ones).
+  bool prestressable = false;           ///< Some combination of the states puts every taut cable in tension.
+  std::vector<ElementForce> prestress;  ///< The tension pattern found, every element of it (largest 1).
+  bool prestressStable = false;         ///< That prestress makes the stress matrix positive on the m modes.
+  std::string stability;                ///< How prestressStable was decided, one readable line.
+};
+
+/// One step of a deployment: the active cable's length and where everything is.
+struct DeploymentStep {
+  double activeLength = 0.0;        ///< [m]
+  int dof = 0;                      ///< Nullity at this step (active cable ignored, slack cables ignored).
+  std::vector<CableState> cables;   ///< Every cable (passive: taut/slack; active: driving).
+  std::vector<JointValue> joints;   ///< A few tree joints' values.
+};
+
+/// A deployment driven by shortening an active cable (DESIGN.md §4 `deployment`).
+struct DeploymentInfo {
+  std::string cable;                    ///< The active cable.
+  double initialLength = 0.0;           ///< [m]
+  double targetLength = 0.0;            ///< Where the continuation was headed [m].
+  double finalLength = 0.0;             ///< Where it stopped [m].
+  int finalDof = 0;                     ///< DOF of the final report (taut cables counted).
+  std::vector<std::string> stoppedBy;   ///< Passive cables that went taut (empty: none did).
+  std::string reason;                   ///< Why it stopped, one readable line.
+  std::vector<DeploymentStep> steps;
+};
+
 /// Everything the CLI prints and the services return; field names follow the JSON keys.
 struct MobilityReport {
   std::string robot;
@@ -111,6 +162,8 @@ struct MobilityReport {
   std::vector<JointValue> positions;   ///< Every tree joint with a single value, in document order.
   AssemblyInfo assembly;
   std::vector<std::string> warnings;   ///< What was read but not understood (one line each).
+  SelfStressInfo selfStress;           ///< States of self-stress and prestress (`self_stress`).
+  std::optional<DeploymentInfo> deployment;  ///< With --deploy: how the final pose was reached.
 };
 
 /**

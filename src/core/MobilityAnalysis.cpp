@@ -11,6 +11,7 @@
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/analysis/FiniteMobility.hpp"
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
+#include "mobility_analysis/analysis/SelfStressReport.hpp"
 
 namespace mobility_analysis {
 
@@ -24,7 +25,36 @@ int computeGrublerKutzbach(const Mechanism& mechanism, const CoordinateModel& mo
   return count;
 }
 
+namespace {
+
+Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const AnalysisOptions& options,
+                                          const std::vector<bool>& lockedCables);
+
+}  // namespace
+
 Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const AnalysisOptions& options) {
+  const bool hasActive = std::any_of(mechanism.joints.begin(), mechanism.joints.end(), [](const Joint& joint) {
+    return joint.kind == ConnectionKind::Cable && joint.cableType == CableType::Active;
+  });
+  if (!options.lockActiveCables || !hasActive)
+    return analyzeAssembled(mechanism, options, {});
+  // Lock at the pose the free mechanism assembles to, then analyse the locked copy from there.
+  Result<AssembledMechanism> free = assembleMechanism(
+      mechanism, options.startPoses ? *options.startPoses : computeTreePoses(mechanism, options.positions),
+      options.mode);
+  if (!isOk(free))
+    return diagnosticOf(free);
+  std::vector<bool> locked;
+  const Mechanism lockedMechanism = lockActiveCables(mechanism, valueOf(free).poses, locked);
+  AnalysisOptions lockedOptions = options;
+  lockedOptions.startPoses = valueOf(free).poses;
+  return analyzeAssembled(lockedMechanism, lockedOptions, locked);
+}
+
+namespace {
+
+Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const AnalysisOptions& options,
+                                          const std::vector<bool>& lockedCables) {
   auto progress = [&](const std::string& phase, double fraction) {
     if (options.progress)
       options.progress(phase, fraction);
@@ -170,15 +200,22 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
       const double distance = ((poses[joint.link1] * joint.frame1.translation()) -
                                (poses[joint.link2] * joint.frame2.translation()))
                                   .norm();
-      const std::string state =
-          joint.cableType == CableType::Active ? "driving" : (model.jointActive[j] ? "taut" : "slack");
-      report.cables.push_back(CableState{joint.name,
-                                         joint.cableType == CableType::Active ? "active" : "passive", state,
-                                         joint.length, distance});
+      const bool locked = j < lockedCables.size() && lockedCables[j];
+      const std::string state = locked                                 ? "locked"
+                                : joint.cableType == CableType::Active ? "driving"
+                                : model.jointActive[j]                 ? "taut"
+                                                                       : "slack";
+      report.cables.push_back(CableState{
+          joint.name, locked || joint.cableType == CableType::Active ? "active" : "passive", state, joint.length,
+          distance});
     }
   }
+  progress("self-stress report", 0.95);
+  report.selfStress = computeSelfStressInfo(mechanism, model, analysis.assembled.q, J, basis);
   progress("done", 1.0);
   return analysis;
 }
+
+}  // namespace
 
 }  // namespace mobility_analysis

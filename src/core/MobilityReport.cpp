@@ -57,6 +57,46 @@ std::string array(const std::vector<T>& items, F&& write) {
   return out + "]";
 }
 
+std::string forceJson(const ElementForce& f) {
+  return "{\"name\": " + quote(f.name) + ", \"kind\": " + quote(f.kind) + ", \"force\": " + number(f.force) + "}";
+}
+
+std::string cableJson(const CableState& c) {
+  return "{\"name\": " + quote(c.name) + ", \"type\": " + quote(c.type) + ", \"state\": " + quote(c.state) +
+         ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) + "}";
+}
+
+std::string selfStressJson(const SelfStressInfo& s) {
+  std::string out = "{\"count\": " + std::to_string(s.count) + ", \"mechanism_modes\": " +
+                    std::to_string(s.mechanismModes) + ", \"states_listed\": " + (s.statesListed ? "true" : "false") +
+                    ", \"states\": " +
+                    array(s.states, [](const SelfStressState& state) { return array(state.elements, forceJson); }) +
+                    ", \"taut_cables\": " + std::to_string(s.tautCables) +
+                    ", \"prestressable\": " + (s.prestressable ? "true" : "false") +
+                    ", \"prestress\": " + array(s.prestress, forceJson) +
+                    ", \"prestress_stable\": " + (s.prestressStable ? "true" : "false") +
+                    ", \"stability\": " + quote(s.stability) + "}";
+  return out;
+}
+
+std::string deploymentJson(const DeploymentInfo& d) {
+  std::string out = "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
+                    ", \"target_length\": " + number(d.targetLength) + ", \"final_length\": " +
+                    number(d.finalLength, 12) + ", \"final_dof\": " + std::to_string(d.finalDof) +
+                    ", \"stopped_by\": " + array(d.stoppedBy, quote) + ", \"reason\": " + quote(d.reason) +
+                    ",\n    \"steps\": [";
+  for (size_t i = 0; i < d.steps.size(); ++i) {
+    const DeploymentStep& step = d.steps[i];
+    out += std::string(i ? ",\n      " : "\n      ") + "{\"active_length\": " + number(step.activeLength, 12) +
+           ", \"dof\": " + std::to_string(step.dof) + ", \"cables\": " + array(step.cables, cableJson) +
+           ", \"joints\": {";
+    for (size_t j = 0; j < step.joints.size(); ++j)
+      out += (j ? ", " : "") + quote(step.joints[j].name) + ": " + number(step.joints[j].value, 12);
+    out += "}}";
+  }
+  return out + "]}";
+}
+
 std::string statusJson(const ElementStatus& s) {
   return "{\"name\": " + quote(s.name) + ", \"kind\": " + quote(s.kind) + ", \"type\": " + quote(s.type) +
          ", \"class\": " + quote(toString(s.elementClass)) + "}";
@@ -131,6 +171,9 @@ std::string toJson(const MobilityReport& r) {
   out << "  \"assembly\": {\"residual\": " << number(r.assembly.residual, 3) << ", \"steps\": " << r.assembly.steps
       << ", \"iterations\": " << r.assembly.iterations << ", \"events\": " << array(r.assembly.events, quote)
       << "},\n";
+  out << "  \"self_stress\": " << selfStressJson(r.selfStress) << ",\n";
+  if (r.deployment)
+    out << "  \"deployment\": " << deploymentJson(*r.deployment) << ",\n";
   out << "  \"warnings\": " << array(r.warnings, quote) << "\n";
   out << "}\n";
   return out.str();
@@ -150,6 +193,10 @@ std::string toText(const MobilityReport& r) {
     out << "    passive: " << m.description << "\n";
   out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints << ", rank "
       << r.rank << "\n";
+  out << "  Calladine-Maxwell: m = num_coordinates - rank = " << r.numCoordinates << " - " << r.rank << " = "
+      << r.selfStress.mechanismModes << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints
+      << " - " << r.rank << " = " << r.selfStress.count << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
+      << " = num_coordinates - num_constraints\n";
   out << "  redundant equations: " << r.numRedundant << " (= dof - Grubler = " << r.dof - r.grublerKutzbachDof
       << ")\n";
   for (const RedundantJoint& j : r.redundantJoints) {
@@ -186,6 +233,26 @@ std::string toText(const MobilityReport& r) {
   for (const CableState& c : r.cables) {
     out << "  cable " << c.name << " (" << c.type << "): " << c.state << ", length " << number(c.length, 6)
         << " m, ends " << number(c.distance, 6) << " m apart\n";
+  }
+  if (r.deployment) {
+    const DeploymentInfo& d = *r.deployment;
+    out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length " << number(d.initialLength, 6)
+        << " m -> " << number(d.finalLength, 9) << " m, final DOF " << d.finalDof << "; " << d.reason << "\n";
+  }
+  const SelfStressInfo& s = r.selfStress;
+  for (size_t k = 0; k < s.states.size() && k < 20; ++k) {
+    out << "    state " << k + 1 << ":";
+    for (size_t e = 0; e < s.states[k].elements.size() && e < 12; ++e)
+      out << " " << s.states[k].elements[e].name << " " << number(s.states[k].elements[e].force, 3);
+    if (s.states[k].elements.size() > 12) out << " ... (" << s.states[k].elements.size() << " elements)";
+    out << "\n";
+  }
+  if (s.states.size() > 20 || !s.statesListed) out << "    ... (" << s.count << " states in all)\n";
+  if (s.tautCables > 0) {
+    out << "  prestress: " << (s.prestressable ? "prestressable" : "NOT prestressable") << " (" << s.tautCables
+        << " taut cables)";
+    if (s.prestressable) out << ", " << (s.prestressStable ? "prestress-stable" : "not prestress-stable");
+    out << "; " << s.stability << "\n";
   }
   out << "  rank margin: smallest kept pivot " << number(r.rankMargin.smallestKeptPivot, 3)
       << ", largest dropped residual " << number(r.rankMargin.largestDroppedResidual, 3) << " (tolerance "

@@ -232,10 +232,13 @@ LinkPoses recoverPoses(const CoordinateModel& model, const Eigen::Ref<const Eige
       Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
       d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
       rotation = svd.matrixV() * d * svd.matrixU().transpose();
-      // A body whose elements are all collinear leaves its spin undetermined: keep the reference's.
+      // A body whose elements are all collinear fixes its line but not its spin about it: turn the
+      // reference's line onto the new one by the least rotation (h = sigma u v^T: local u goes to world v).
       const Eigen::Vector3d singular = svd.singularValues();
       if (singular(1) < 1e-9 * singular(0)) {
-        rotation = reference[b].linear();
+        const Eigen::Vector3d referenceLine = reference[b].linear() * svd.matrixU().col(0);
+        rotation = Eigen::Quaterniond::FromTwoVectors(referenceLine, svd.matrixV().col(0)).toRotationMatrix() *
+                   reference[b].linear();
       }
     }
     poses[b].linear() = rotation;

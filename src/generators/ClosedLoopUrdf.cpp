@@ -4,6 +4,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <sstream>
 #include <unordered_map>
@@ -427,6 +428,27 @@ void writeLayout(const MechanismDescription& mechanism, const ClosedLoopLayout& 
       }
       chunk += "  </loop_joint>\n";
     }
+    flush(false);
+  }
+  std::unordered_map<std::string, size_t> linkIndex;
+  if (!mechanism.cables.empty()) {
+    for (size_t l = 0; l < layout.links.size(); ++l) linkIndex[layout.links[l]] = l;
+  }
+  for (const CableDescription& cable : mechanism.cables) {
+    // Ends in their links' frames at the written pose (the layout's world frames).
+    auto localPoint = [&](const std::string& link, const Eigen::Vector3d& world) {
+      const auto it = linkIndex.find(link);
+      const size_t index = it == linkIndex.end() ? 0 : it->second;
+      return Eigen::Vector3d(layout.linkFrames[index].inverse() * world);
+    };
+    char length[40];
+    std::snprintf(length, sizeof(length), "%.17g", cable.length);
+    chunk += "  <cable name=\"" + cable.name + "\" type=\"" + (cable.active ? "active" : "passive") +
+             "\" length=\"" + length + "\">\n    <link1 link=\"" + cable.link1 + "\" xyz=\"";
+    appendTriple(chunk, localPoint(cable.link1, cable.point1));
+    chunk += "\"/>\n    <link2 link=\"" + cable.link2 + "\" xyz=\"";
+    appendTriple(chunk, localPoint(cable.link2, cable.point2));
+    chunk += "\"/>\n  </cable>\n";
     flush(false);
   }
   chunk += "</robot>\n";

@@ -80,6 +80,15 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"sle_triangular", 1, 1, "sle_triangular N",
        "triangular-prism scissor mast, spherical face pins; spatial DOF 1 G 3-6N R 6N-2"},
       {"hoberman", 1, 1, "hoberman N (N >= 3)", "Hoberman-type ring; planar DOF 1 G -3 R 4"},
+      {"sle_deployable", 1, 2, "sle_deployable N [ELEVATION_DEG=10]",
+       "SLE mast with passive side cables (taut at 45 deg) and an active base cable; planar DOF 1, deployed 0"},
+      {"sle_deployable_folded", 0, 0, "sle_deployable_folded", "= sle_deployable 4 10"},
+      {"sle_deployable_partly", 0, 0, "sle_deployable_partly", "= sle_deployable 4 30"},
+      {"sle_deployable_deployed", 0, 0, "sle_deployable_deployed", "= sle_deployable 4 45"},
+      {"ring_pantograph", 1, 2, "ring_pantograph N (N >= 3) [OPENING_DEG=150]",
+       "angulated SLE ring with passive hoop cables (taut at 60 deg) and an active cable; planar DOF 1, deployed 0"},
+      {"ring_pantograph_folded", 0, 0, "ring_pantograph_folded", "= ring_pantograph 4 150"},
+      {"ring_pantograph_deployed", 0, 0, "ring_pantograph_deployed", "= ring_pantograph 4 60"},
       {"parallelogram_grid", 2, 2, "parallelogram_grid R C",
        "R x C grid of continuous bars; planar DOF 1 G R+C+1-2RC R 2RC-R-C"},
   };
@@ -202,6 +211,25 @@ GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& r
           std::to_string(n[0])};
     }
     mechanism = makeHobermanRing(n[0]);
+  } else if (family == "sle_deployable") {
+    if (n.size() > 1 && n[1] > 45) {
+      return GeneratorError{"sle_deployable: ELEVATION_DEG must be in 1..45 (the passive cables stop it at 45), got " +
+                            std::to_string(n[1])};
+    }
+    mechanism = makeSleDeployableMast(n.at(0), n.size() > 1 ? n[1] : 10.0);
+  } else if (family == "sle_deployable_folded" || family == "sle_deployable_partly" ||
+             family == "sle_deployable_deployed") {
+    const double elevation = family == "sle_deployable_folded" ? 10.0 : family == "sle_deployable_partly" ? 30.0 : 45.0;
+    mechanism = makeSleDeployableMast(4, elevation);
+    mechanism.name = family;
+  } else if (family == "ring_pantograph") {
+    if (n.at(0) < 3 || (n.size() > 1 && (n[1] < 60 || n[1] > 179))) {
+      return GeneratorError{"ring_pantograph: N must be at least 3 and OPENING_DEG in 60..179 (it deploys to 60)"};
+    }
+    mechanism = makeRingPantograph(n[0], n.size() > 1 ? n[1] : 150.0);
+  } else if (family == "ring_pantograph_folded" || family == "ring_pantograph_deployed") {
+    mechanism = makeRingPantograph(4, family == "ring_pantograph_folded" ? 150.0 : 60.0);
+    mechanism.name = family;
   } else if (family == "parallelogram_grid") {
     mechanism = makeParallelogramGrid(n.at(0), n.at(1));
   } else {

@@ -170,6 +170,11 @@ void scaleMechanism(MechanismDescription& mechanism, double factor) {
     connection.frame.translation() *= factor;
     connection.point2 *= factor;
   }
+  for (CableDescription& cable : mechanism.cables) {
+    cable.point1 *= factor;
+    cable.point2 *= factor;
+    cable.length *= factor;
+  }
   mechanism.visualRadius *= factor;
 }
 

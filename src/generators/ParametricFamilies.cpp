@@ -1,6 +1,10 @@
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace mobility_analysis {
@@ -32,9 +36,9 @@ std::vector<FamilyExpectation> expectSlePlanarMast(int units) {
   return {expectation("planar", 1, 1), expectation("spatial", 1, 1 - 3 * units)};
 }
 
-MechanismDescription makeSlePlanarMast(int units) {
+MechanismDescription makeSlePlanarMast(int units, double elevationDeg) {
   const double barLength = 1.0;
-  const double elevation = 50 * kDeg;
+  const double elevation = elevationDeg * kDeg;
   const double w = barLength * std::cos(elevation);
   const double h = barLength * std::sin(elevation);
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
@@ -200,10 +204,10 @@ std::vector<FamilyExpectation> expectHobermanRing(int units) {
   return {expectation("planar", 1, -3), expectation("spatial", 1, -3 * units - 6)};
 }
 
-MechanismDescription makeHobermanRing(int units) {
+MechanismDescription makeHobermanRing(int units, double openingDeg) {
   const double arm = 0.5;
   const double kappa = 2.0 * M_PI / units;
-  const double opening = 70 * kDeg;  // angle between the two bars' first arms at the kink
+  const double opening = openingDeg * kDeg;  // angle between the two bars' first arms at the kink
   const double phase = 100 * kDeg;
   auto rot2 = [](double angle, const Eigen::Vector2d& v) {
     return Eigen::Vector2d(std::cos(angle) * v.x() - std::sin(angle) * v.y(),
@@ -341,6 +345,100 @@ MechanismDescription makeParallelogramGrid(int rows, int columns) {
   }
   m.visualRadius = 0.012;
   m.expectations = expectParallelogramGrid(rows, columns);
+  return m;
+}
+
+
+// ---------------------------------------------------------------------------------------------------------
+namespace {
+
+/// The point p of unit j of makeHobermanRing (its kink at 0), for cables; same formulas as the ring.
+struct RingGeometry {
+  Eigen::Vector2d a1, b1, a2, b2, centre;
+  double kappa = 0.0;
+  RingGeometry(int units, double openingDeg) {
+    const double arm = 0.5, phase = 100 * kDeg, opening = openingDeg * kDeg;
+    kappa = 2.0 * M_PI / units;
+    const Eigen::Rotation2Dd rk(kappa);
+    const Eigen::Vector2d u1(std::cos(phase), std::sin(phase));
+    const Eigen::Vector2d v1(std::cos(phase + opening), std::sin(phase + opening));
+    a1 = arm * u1;
+    b1 = arm * v1;
+    a2 = -arm * (rk * u1);
+    b2 = -arm * (rk * v1);
+    centre = (Eigen::Matrix2d::Identity() - rk.toRotationMatrix()).fullPivLu().solve(b2 - rk * a1);
+  }
+  Eigen::Vector3d place(int j, const Eigen::Vector2d& p) const {
+    const Eigen::Vector2d q = centre + Eigen::Rotation2Dd(j * kappa) * (p - centre);
+    return Eigen::Vector3d(q.x(), q.y(), 0.0);
+  }
+};
+
+}  // namespace
+
+MechanismDescription makeSleDeployableMast(int units, double elevationDeg, double deployedDeg) {
+  MechanismDescription m = makeSlePlanarMast(units, elevationDeg);
+  const double w = std::cos(elevationDeg * kDeg), h = std::sin(elevationDeg * kDeg);
+  const double taut = std::sin(deployedDeg * kDeg);
+  char angles[120];
+  std::snprintf(angles, sizeof(angles), "%g deg (deployed at %g deg)", elevationDeg, deployedDeg);
+  m.name = "sle_deployable_" + std::to_string(units);
+  m.comment =
+      "Deployable planar scissor (SLE) mast of " + std::to_string(units) +
+      " units (the lecture's stacked SLE mast), written at elevation " + angles +
+      ".\nBars 1 m at elevation beta above the base line: unit k spans x in [0, cos beta], y in [(k-1) sin beta, k sin "
+      "beta];\nbar_k_a rises from the left foot (0, (k-1)h) to the right top, bar_k_b from the right foot to the left top,"
+      "\npinned at their midpoints; unit k+1's feet pinned to unit k's tops; base: bar_1_a pinned to the ground at"
+      "\n(0,0), bar_1_b's foot pinned to a slider on the x axis. One freedom: beta (0 folded flat, 90 a line).\n"
+      "Cables: passive_k (one per unit) from bar_k_a's foot to bar_k_b's top, the unit's left side, of length\n"
+      "sin(deployed) m: slack while beta < deployed, taut at the deployed angle, which it stops. active_base:\n"
+      "active, from the ground pin (0,0) to the slider's pin (cos beta, 0), written at its current length;\n"
+      "shortening it pulls the slider in and raises the mast (DESIGN.md §2: ignored as the driver).\n"
+      "Expected (planar): folded or partly deployed DOF 1, Gruebler 1, redundant 0, passive cables slack;\n"
+      "deployed: every passive cable taut, DOF 0, Gruebler 1 - N, N - 1 states of self-stress, not prestressable\n"
+      "(all passive cables resist the same motion); with the active cable locked (--lock-active-cables) N states,\n"
+      "prestressable (the base cable shortens as the passive cables lengthen), first-order rigid.";
+  auto bar = [](int k, char side) { return "bar_" + std::to_string(k) + "_" + side; };
+  for (int k = 1; k <= units; ++k) {
+    const double y0 = (k - 1) * h;
+    m.cables.push_back(CableDescription{indexed("passive_", k), bar(k, 'a'), Eigen::Vector3d(0, y0, 0), bar(k, 'b'),
+                                        Eigen::Vector3d(0, y0 + h, 0), taut, false});
+  }
+  m.cables.push_back(
+      CableDescription{"active_base", "ground", Eigen::Vector3d::Zero(), "slider", Eigen::Vector3d(w, 0, 0), w, true});
+  const bool deployed = std::abs(elevationDeg - deployedDeg) < 1e-12;
+  m.expectations = {expectation("planar", deployed ? 0 : 1, deployed ? 1 - units : 1)};
+  return m;
+}
+
+MechanismDescription makeRingPantograph(int units, double openingDeg, double deployedOpeningDeg) {
+  MechanismDescription m = makeHobermanRing(units, openingDeg);
+  const RingGeometry now(units, openingDeg), deployed(units, deployedOpeningDeg);
+  const double hoop = (deployed.place(1, Eigen::Vector2d::Zero()) - deployed.place(0, Eigen::Vector2d::Zero())).norm();
+  char angles[120];
+  std::snprintf(angles, sizeof(angles), "%g deg (deployed at %g deg)", openingDeg, deployedOpeningDeg);
+  m.name = "ring_pantograph_" + std::to_string(units);
+  m.comment =
+      "Ring pantograph of " + std::to_string(units) +
+      " angulated SLE units with a cable net (after You & Pellegrino 1997), written at opening " + angles +
+      ".\nThe ring is hoberman_ring's (below): it expands as the opening between the first arms of each unit"
+      "\ndecreases (180 deg: collapsed to a point, 90 deg: the first arms' ends coincide across units).\n"
+      "Cables: hoop_j (passive) from kink_j to kink_(j+1) (each on bar_j_a), of the chord length at the deployed"
+      "\nopening: slack while the ring is smaller, taut when deployed. active_unit0 (active) from bar_0_a's end 1 to"
+      "\nbar_0_b's end 1 (2 arm sin(opening/2)): shortening it closes unit 0's first arms and expands the ring.\n"
+      "Expected (planar): folded DOF 1, Gruebler -3, redundant 4; deployed DOF 0, Gruebler -3 - N,\n"
+      "4 + N - 1 states of self-stress, not prestressable; active cable locked: 4 + N states, prestressable.\n" +
+      m.comment;
+  auto bar = [](int j, char side) { return "bar_" + std::to_string(j) + "_" + side; };
+  for (int j = 0; j < units; ++j) {
+    const int next = (j + 1) % units;
+    m.cables.push_back(CableDescription{indexed("hoop_", j), bar(j, 'a'), now.place(j, Eigen::Vector2d::Zero()),
+                                        bar(next, 'a'), now.place(next, Eigen::Vector2d::Zero()), hoop, false});
+  }
+  m.cables.push_back(CableDescription{"active_unit0", bar(0, 'a'), now.place(0, now.a1), bar(0, 'b'),
+                                      now.place(0, now.b1), (now.a1 - now.b1).norm(), true});
+  const bool isDeployed = std::abs(openingDeg - deployedOpeningDeg) < 1e-12;
+  m.expectations = {expectation("planar", isDeployed ? 0 : 1, isDeployed ? -3 - units : -3)};
   return m;
 }
 

@@ -1,15 +1,19 @@
 /// mobility_report FILE [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1]
-/// [--rank-tolerance T] [--json] Prints the mobility report of a closed-loop URDF or an MJCF model, with the
-/// --positions joints held at their values; warnings go to stderr as "warning: ..." lines; on bad input one
-/// line on stderr and exit code 2.
+/// [--rank-tolerance T] [--lock-active-cables] [--deploy CABLE [--steps N] [--deploy-to LENGTH]] [--json]
+/// Prints the mobility report of a closed-loop URDF or an MJCF model, with the --positions joints held at
+/// their values; warnings go to stderr as "warning: ..." lines; on bad input one line on stderr and exit
+/// code 2.
 
 #include <chrono>
+#include <cmath>
+#include <optional>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <string>
 
 #include "mobility_analysis/mobility_analysis.hpp"
+#include "mobility_analysis/motion/Deployment.hpp"
 
 namespace {
 
@@ -22,7 +26,8 @@ int fail(const std::string& line) {
 
 const char* kUsage =
     "usage: mobility_report FILE.urdf|FILE.xml [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] "
-    "[--positions j1=0.3,j2=-1] [--rank-tolerance T] [--json]";
+    "[--positions j1=0.3,j2=-1] [--rank-tolerance T] [--lock-active-cables] "
+    "[--deploy CABLE [--steps N] [--deploy-to LENGTH]] [--json]";
 
 /// --help: the usage line and what --positions does (errors print the usage line alone: one line).
 const char* kPositionsHelp =
@@ -39,6 +44,10 @@ int main(int argc, char** argv) {
     double rankTolerance = -1.0;
     bool json = false;
     ReadOptions readOptions;
+    bool lockActiveCables = false;
+    std::string deployCable;
+    int deploySteps = 100;
+    std::optional<double> deployTo;
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
       auto next = [&](const std::string& option) -> const char* {
@@ -51,6 +60,26 @@ int main(int argc, char** argv) {
         json = true;
       } else if (arg == "--strict") {
         readOptions.strict = true;
+      } else if (arg == "--lock-active-cables") {
+        lockActiveCables = true;
+      } else if (arg == "--deploy" || arg == "--steps" || arg == "--deploy-to") {
+        const char* value = next(arg);
+        if (value == nullptr)
+          return fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage);
+        char* end = nullptr;
+        if (arg == "--deploy") {
+          deployCable = value;
+        } else if (arg == "--steps") {
+          const long steps = std::strtol(value, &end, 10);
+          if (*end != '\0' || steps < 1 || steps > 10000000)
+            return fail(std::string("mobility_report: --steps '") + value + "' is not a whole number >= 1");
+          deploySteps = static_cast<int>(steps);
+        } else {
+          const double length = std::strtod(value, &end);
+          if (*end != '\0' || !(length >= 0.0 && std::isfinite(length)))
+            return fail(std::string("mobility_report: --deploy-to '") + value + "' is not a length >= 0");
+          deployTo = length;
+        }
       } else if (arg == "--mode" || arg == "--positions" || arg == "--rank-tolerance" || arg == "--closures") {
         const char* value = next(arg);
         if (value == nullptr)
@@ -116,7 +145,14 @@ int main(int argc, char** argv) {
         last = fraction;
       }
     };
-    const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+    options.lockActiveCables = lockActiveCables;
+    DeploymentOptions deployment;
+    deployment.cable = deployCable;
+    deployment.steps = deploySteps;
+    deployment.targetLength = deployTo;
+    deployment.analysis = options;
+    const Result<MobilityAnalysis> analysis = deployCable.empty() ? analyzeMechanism(valueOf(mechanism), options)
+                                                                  : deployMechanism(valueOf(mechanism), deployment);
     if (!isOk(analysis))
       return fail(diagnosticOf(analysis).toString());
     // The report is written only once its own invariants hold (finite numbers, consistent counts).

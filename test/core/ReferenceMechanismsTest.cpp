@@ -60,6 +60,12 @@ const std::vector<Reference>& references() {
       {"delta_robot.urdf", AnalysisMode::Spatial, 9, 9, 0, {}, {}, true, -1, 6},
       {"sle_mast.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
       {"hoberman_ring.urdf", AnalysisMode::Planar, 1, -3, 4, {}, {}},
+      // Deployable models (issue 12): a slack cable counts nothing, a taut one is a distance constraint.
+      {"sle_deployable_folded.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
+      {"sle_deployable_partly.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
+      {"sle_deployable_deployed.urdf", AnalysisMode::Planar, 0, -3, 3, {}, {}},
+      {"ring_pantograph_folded.urdf", AnalysisMode::Planar, 1, -3, 4, {}, {}},
+      {"ring_pantograph_deployed.urdf", AnalysisMode::Planar, 0, -7, 7, {}, {}},
   };
   return table;
 }

@@ -83,6 +83,17 @@ struct FamilyExpectation {
   int redundant = 0;  ///< Number of redundant equations = dof − grubler.
 };
 
+/// A cable between two world points on two links (DESIGN.md §2): never a tree joint, never in Grübler.
+struct CableDescription {
+  std::string name;
+  std::string link1;
+  Eigen::Vector3d point1 = Eigen::Vector3d::Zero();  ///< World end on link1 [m].
+  std::string link2;
+  Eigen::Vector3d point2 = Eigen::Vector3d::Zero();  ///< World end on link2 [m].
+  double length = 0.0;                               ///< Declared length [m].
+  bool active = false;                               ///< Active (the driver) or passive.
+};
+
 /// A mechanism at one configuration: links, connections and what the analysis should report.
 struct MechanismDescription {
   std::string name;                             ///< URDF robot name.
@@ -90,6 +101,7 @@ struct MechanismDescription {
   std::vector<LinkDescription> links;           ///< links.front() is the ground (URDF root).
   std::vector<Connection> connections;          ///< In document order; the order decides the spanning tree.
   std::vector<FamilyExpectation> expectations;  ///< One per mode the model is meant to be analysed in.
+  std::vector<CableDescription> cables;         ///< Written after the loop joints as `<cable>` elements.
   double visualRadius = 0.01;                   ///< Radius of the drawn cylinders [m].
 };
 

@@ -22,7 +22,7 @@ std::vector<FamilyExpectation> expectSlePlanarMast(int units);
  * @param[in] units N ≥ 1.
  * @note Expectations: see expectSlePlanarMast().
  */
-MechanismDescription makeSlePlanarMast(int units);
+MechanismDescription makeSlePlanarMast(int units, double elevationDeg = 50.0);
 
 /**
  * @brief Closed-form expectations of the scissor mast analysed in space (makeSleSpatialMast()).
@@ -89,7 +89,7 @@ std::vector<FamilyExpectation> expectHobermanRing(int units);
  * @param[in] units N ≥ 3.
  * @note Expectations: see expectHobermanRing().
  */
-MechanismDescription makeHobermanRing(int units);
+MechanismDescription makeHobermanRing(int units, double openingDeg = 70.0);
 
 /**
  * @brief Closed-form expectations of a door on @p hinges coaxial hinges.
@@ -128,5 +128,19 @@ std::vector<FamilyExpectation> expectParallelogramGrid(int rows, int columns);
  * @note Expectations: see expectParallelogramGrid().
  */
 MechanismDescription makeParallelogramGrid(int rows, int columns);
+
+/**
+ * @brief The lecture's deployable SLE mast: makeSlePlanarMast() at elevation @p elevationDeg with one passive
+ * cable per unit (its left side, taut at @p deployedDeg) and an active cable across the base (pin to slider).
+ * @note Expectations (planar): DOF 1, Gruebler 1 below the deployed angle; DOF 0, Gruebler 1 - N at it.
+ */
+MechanismDescription makeSleDeployableMast(int units, double elevationDeg, double deployedDeg = 45.0);
+
+/**
+ * @brief A ring pantograph with a cable net: makeHobermanRing() at @p openingDeg with passive hoop cables
+ * between consecutive kinks (taut at @p deployedOpeningDeg) and an active cable across unit 0's first arms.
+ * @note Expectations (planar): DOF 1, Gruebler -3 before deployment; DOF 0, Gruebler -3 - N deployed.
+ */
+MechanismDescription makeRingPantograph(int units, double openingDeg, double deployedOpeningDeg = 60.0);
 
 }  // namespace mobility_analysis

@@ -1,0 +1,216 @@
+#include "mobility_analysis/analysis/SelfStressReport.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/QR>
+
+#include "mobility_analysis/analysis/Prestress.hpp"
+
+namespace mobility_analysis {
+
+namespace {
+
+/// An element's share below this fraction of the state's largest is rounding, not support.
+constexpr double kSupportFloor = 1e-9;
+/// An eigenvalue of N^T Omega N above this fraction of |Omega| counts as positive.
+constexpr double kStiffnessFloor = 1e-9;
+
+bool isDistanceLike(const Joint& joint) {
+  return joint.kind == ConnectionKind::Cable || joint.kind == ConnectionKind::DistanceConstraint;
+}
+
+/// The elements carrying a multiplier vector given as (row, value) pairs, forces relative to the largest.
+template <class Entries>
+std::vector<ElementForce> elementForces(const Mechanism& mechanism, const CoordinateModel& model,
+                                        const Entries& entries) {
+  // key: (source, element) -> signed force (distance-like) or sum of squares.
+  std::map<std::pair<int, int>, double> signedForce, squares;
+  for (const auto& [row, value] : entries) {
+    const ConstraintEquation& eq = model.equations[row];
+    const std::pair<int, int> key{static_cast<int>(eq.source), eq.element};
+    if (eq.source == EquationSource::Joint && isDistanceLike(mechanism.joints[eq.element]) &&
+        eq.kind == EquationKind::Distance) {
+      // |p2 - p1|^2 = L^2 with multiplier y: axial force 2 y L, tension positive.
+      signedForce[key] += 2.0 * value * std::sqrt(std::max(eq.value, 0.0));
+    } else {
+      squares[key] += value * value;
+    }
+  }
+  std::vector<ElementForce> forces;
+  auto name = [&](const std::pair<int, int>& key, std::string& kind) {
+    const auto source = static_cast<EquationSource>(key.first);
+    if (source == EquationSource::Joint) {
+      kind = toString(mechanism.joints[key.second].kind);
+      return mechanism.joints[key.second].name;
+    }
+    kind = source == EquationSource::Link ? "link" : "boundary";
+    return mechanism.links[key.second].name;
+  };
+  for (const auto& [key, force] : signedForce) {
+    ElementForce f;
+    f.name = name(key, f.kind);
+    f.force = force;
+    forces.push_back(f);
+  }
+  for (const auto& [key, sum] : squares) {
+    ElementForce f;
+    f.name = name(key, f.kind);
+    f.force = std::sqrt(sum);
+    forces.push_back(f);
+  }
+  double largest = 0.0;
+  for (const ElementForce& f : forces)
+    largest = std::max(largest, std::abs(f.force));
+  // Sign of a state is free: make its largest signed (cable / distance) force a tension.
+  double largestSigned = 0.0;
+  for (const auto& [key, force] : signedForce) {
+    if (std::abs(force) > std::abs(largestSigned))
+      largestSigned = force;
+  }
+  const double sign = largestSigned < 0.0 ? -1.0 : 1.0;
+  std::vector<ElementForce> kept;
+  if (largest <= 0.0)
+    return kept;
+  for (ElementForce& f : forces) {
+    const bool isSigned = f.kind == "cable" || f.kind == "distance_constraint";
+    f.force = (isSigned ? sign : 1.0) * f.force / largest;
+    if (std::abs(f.force) > kSupportFloor)
+      kept.push_back(f);
+  }
+  std::stable_sort(kept.begin(), kept.end(), [](const ElementForce& a, const ElementForce& b) {
+    return std::abs(a.force) > std::abs(b.force);
+  });
+  return kept;
+}
+
+}  // namespace
+
+std::vector<int> findTautCableRows(const Mechanism& mechanism, const CoordinateModel& model) {
+  std::vector<int> rows;
+  for (int r = 0; r < model.numConstraints(); ++r) {
+    const ConstraintEquation& eq = model.equations[r];
+    if (eq.source == EquationSource::Joint && mechanism.joints[eq.element].kind == ConnectionKind::Cable &&
+        eq.kind == EquationKind::Distance)
+      rows.push_back(r);
+  }
+  return rows;
+}
+
+Mechanism lockActiveCables(const Mechanism& mechanism, const LinkPoses& poses, std::vector<bool>& locked) {
+  Mechanism copy = mechanism;
+  locked.assign(mechanism.joints.size(), false);
+  for (size_t j = 0; j < copy.joints.size(); ++j) {
+    Joint& joint = copy.joints[j];
+    if (joint.kind != ConnectionKind::Cable || joint.cableType != CableType::Active)
+      continue;
+    joint.cableType = CableType::Passive;
+    joint.length = ((poses[joint.link1] * joint.frame1.translation()) -
+                    (poses[joint.link2] * joint.frame2.translation()))
+                       .norm();
+    locked[j] = true;
+  }
+  return copy;
+}
+
+std::vector<SelfStress> toEquilibriumStresses(const std::vector<SelfStress>& stresses,
+                                              const SparseJacobian& J) {
+  std::vector<SelfStress> result;
+  result.reserve(stresses.size());
+  for (const SelfStress& stress : stresses) {
+    SelfStress scaled;
+    scaled.reserve(stress.size());
+    double largest = 0.0;
+    for (const auto& [row, value] : stress) {
+      const double norm = J.row(row).norm();
+      if (norm <= 0.0)
+        continue;
+      scaled.emplace_back(row, value / norm);
+      largest = std::max(largest, std::abs(value / norm));
+    }
+    for (auto& entry : scaled)
+      entry.second /= largest > 0.0 ? largest : 1.0;
+    result.push_back(std::move(scaled));
+  }
+  return result;
+}
+
+Eigen::VectorXd toMultipliers(const SelfStress& stress, int numConstraints) {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(numConstraints);
+  for (const auto& [row, value] : stress)
+    y(row) += value;
+  return y;
+}
+
+SelfStressInfo computeSelfStressInfo(const Mechanism& mechanism, const CoordinateModel& model,
+                                     const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J,
+                                     const SelfStressBasis& basis) {
+  SelfStressInfo info;
+  info.count = basis.numConstraints - basis.rank;
+  info.mechanismModes = basis.numCoordinates - basis.rank;
+  const std::vector<SelfStress> stresses = toEquilibriumStresses(basis.stresses, J);
+  info.statesListed = stresses.size() <= kMaxListedStates;
+  if (info.statesListed) {
+    info.states.reserve(stresses.size());
+    for (const SelfStress& stress : stresses)
+      info.states.push_back(SelfStressState{elementForces(mechanism, model, stress)});
+  }
+
+  const std::vector<int> cableRows = findTautCableRows(mechanism, model);
+  info.tautCables = static_cast<int>(cableRows.size());
+  if (cableRows.empty()) {
+    info.stability = "no taut cables to prestress";
+    return info;
+  }
+  const CablePrestress prestress = findCablePrestress(stresses, model.numConstraints(), cableRows);
+  info.prestressable = prestress.feasible;
+  if (!prestress.feasible) {
+    info.stability = stresses.empty() ? "no state of self-stress: the taut cables cannot be pretensioned"
+                                      : "no combination of the states tensions every taut cable";
+    return info;
+  }
+  std::vector<std::pair<int, double>> entries;
+  for (int r = 0; r < prestress.multipliers.size(); ++r) {
+    if (prestress.multipliers(r) != 0.0)
+      entries.emplace_back(r, prestress.multipliers(r));
+  }
+  info.prestress = elementForces(mechanism, model, entries);
+
+  // Second-order test on the first-order motions.
+  const int m = info.mechanismModes;
+  if (m == 0) {
+    info.prestressStable = true;
+    info.stability = "first-order rigid (m = 0): the prestress has no mechanism mode to stiffen";
+    return info;
+  }
+  if (model.numCoordinates() > kMaxStabilityCoordinates) {
+    char what[160];
+    std::snprintf(what, sizeof(what), "not decided: %d mechanism modes over %d coordinates (limit %d)", m,
+                  model.numCoordinates(), kMaxStabilityCoordinates);
+    info.stability = what;
+    return info;
+  }
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(J);
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(dense);
+  lu.setThreshold(basis.smallestKeptPivot > 0.0 ? std::min(1e-8, 0.1 * basis.smallestKeptPivot) : 1e-8);
+  const Eigen::MatrixXd kernel = lu.kernel();
+  const Eigen::MatrixXd N = Eigen::HouseholderQR<Eigen::MatrixXd>(kernel).householderQ() *
+                            Eigen::MatrixXd::Identity(kernel.rows(), kernel.cols());
+  const Eigen::MatrixXd omega = Eigen::MatrixXd(computeStressedHessian(model, q, prestress.multipliers));
+  const Eigen::MatrixXd reduced = N.transpose() * omega * N;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(0.5 * (reduced + reduced.transpose()));
+  const double scale = std::max(1.0, omega.cwiseAbs().maxCoeff());
+  const double smallest = eigen.eigenvalues().size() ? eigen.eigenvalues().minCoeff() : 0.0;
+  info.prestressStable = kernel.cols() == m && smallest > kStiffnessFloor * scale;
+  char what[200];
+  std::snprintf(what, sizeof(what), "stress matrix on the %d mechanism modes: smallest eigenvalue %.3g (%s)",
+                m, smallest, info.prestressStable ? "positive definite" : "not positive definite");
+  info.stability = what;
+  return info;
+}
+
+}  // namespace mobility_analysis
