@@ -58,6 +58,7 @@ const std::vector<Reference>& references() {
       // Passive freedoms (Tsai 1999): each leg or rod spins about its own line.
       {"stewart_6sps.urdf", AnalysisMode::Spatial, 12, 12, 0, {}, {}, true, -1, 6},
       {"delta_robot.urdf", AnalysisMode::Spatial, 9, 9, 0, {}, {}, true, -1, 6},
+      {"peaucellier.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
       {"sle_mast.urdf", AnalysisMode::Planar, 1, 1, 0, {}, {}},
       {"hoberman_ring.urdf", AnalysisMode::Planar, 1, -3, 4, {}, {}},
       // Deployable models (issue 12): a slack cable counts nothing, a taut one is a distance constraint.
