@@ -13,24 +13,46 @@ namespace {
 constexpr double kRateStep = 1e-6;
 /// A joint adds a direction when its rate row keeps this much of its norm off the rows chosen before it [-].
 constexpr double kIndependent = 1e-5;
+/// Singular values below this fraction of the largest span the null space [-].
+constexpr double kNullTolerance = 1e-9;
 
 }  // namespace
 
 std::vector<std::string> findDriveableJoints(const Mechanism& mechanism, const MobilityAnalysis& analysis) {
-  const CoordinateModel& model = analysis.assembled.model;
   const int dof = analysis.report.dof;
   std::vector<std::string> chosen;
-  if (dof <= 0 || model.numCoordinates() > kMaxDriveableSearchCoordinates)
+  const LinkPoses& poses = analysis.assembled.poses;
+  // Planar coordinates do not give back the links' turns (recoverPoses keeps the reference's rotations
+  // there), so the rates come from the spatial model at the same pose; its null space holds the planar
+  // motions.
+  CoordinateModel spatial;
+  const CoordinateModel* model = &analysis.assembled.model;
+  Eigen::VectorXd q = analysis.assembled.q;
+  if (model->mode == AnalysisMode::Planar) {
+    Result<CoordinateModel> built =
+        buildCoordinateModel(mechanism, poses, AnalysisMode::Spatial, model->characteristicLength);
+    if (!isOk(built))
+      return chosen;
+    spatial = valueOf(std::move(built));
+    model = &spatial;
+    q = computeCoordinates(spatial, poses);
+  }
+  if (dof <= 0 || model->numCoordinates() > kMaxDriveableSearchCoordinates)
     return chosen;
-  const Eigen::MatrixXd J = Eigen::MatrixXd(computeConstraintJacobian(model, analysis.assembled.q));
+  const Eigen::MatrixXd J = Eigen::MatrixXd(computeConstraintJacobian(*model, q));
   Eigen::MatrixXd nullSpace;
   if (J.rows() == 0) {
-    nullSpace = Eigen::MatrixXd::Identity(model.numCoordinates(), model.numCoordinates());
+    nullSpace = Eigen::MatrixXd::Identity(model->numCoordinates(), model->numCoordinates());
   } else {
     Eigen::BDCSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
-    nullSpace = svd.matrixV().rightCols(std::min<int>(dof, static_cast<int>(svd.matrixV().cols())));
+    int rank = 0;
+    const double largest = svd.singularValues().size() ? svd.singularValues()(0) : 0.0;
+    for (int i = 0; i < svd.singularValues().size(); ++i) {
+      if (svd.singularValues()(i) > kNullTolerance * largest)
+        ++rank;
+    }
+    nullSpace = svd.matrixV().rightCols(model->numCoordinates() - rank);
   }
-  const LinkPoses& poses = analysis.assembled.poses;
   const JointPositions here = computeJointPositions(mechanism, poses);
   // rates(j, i): rate of tree joint j along null vector i.
   std::vector<std::string> names;
@@ -41,10 +63,9 @@ std::vector<std::string> findDriveableJoints(const Mechanism& mechanism, const M
   Eigen::MatrixXd rates(names.size(), nullSpace.cols());
   for (int i = 0; i < nullSpace.cols(); ++i) {
     const Eigen::VectorXd step = kRateStep * nullSpace.col(i);
-    const JointPositions plus =
-        computeJointPositions(mechanism, recoverPoses(model, analysis.assembled.q + step, poses), here);
+    const JointPositions plus = computeJointPositions(mechanism, recoverPoses(*model, q + step, poses), here);
     const JointPositions minus =
-        computeJointPositions(mechanism, recoverPoses(model, analysis.assembled.q - step, poses), here);
+        computeJointPositions(mechanism, recoverPoses(*model, q - step, poses), here);
     for (size_t j = 0; j < names.size(); ++j) {
       rates(j, i) = (plus.at(names[j]) - minus.at(names[j])) / (2.0 * kRateStep);
     }
