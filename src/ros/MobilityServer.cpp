@@ -10,7 +10,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "mobility_analysis/UrdfLoader.hpp"
+#include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/ros/DriveableJoints.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
 
@@ -170,10 +170,8 @@ bool MobilityServer::readParameters() {
     return false;
   }
 
-  if (privateNodeHandle_.hasParam("closures")) {
-    // TODO(readers): read the closure file through readMechanismFromString once the readers' front door is
-    // in.
-    ROS_FATAL("Parameter '%s' is not supported by this build (the closure-file reader is not in it)",
+  if (privateNodeHandle_.hasParam("closures") && !privateNodeHandle_.getParam("closures", closuresFile_)) {
+    ROS_FATAL("Parameter '%s' must be a string (the path of a closure file)",
               privateNodeHandle_.resolveName("closures").c_str());
     return false;
   }
@@ -224,9 +222,14 @@ Result<std::shared_ptr<MobilityServer::State>> MobilityServer::loadDescription(c
                                                                                AnalysisMode mode) const {
   const auto start = std::chrono::steady_clock::now();
   try {
-    Result<Mechanism> mechanism = loadMechanismFromString(urdfText, source);
+    // Any URDF dialect or MJCF text, with the ~closures file if one is given (README, "Formats").
+    ReadOptions readOptions;
+    readOptions.closuresFile = closuresFile_;
+    Result<Mechanism> mechanism = readMechanismFromString(urdfText, source, readOptions);
     if (!isOk(mechanism))
       return diagnosticOf(mechanism);
+    for (const Diagnostic& warning : valueOf(mechanism).warnings)
+      ROS_WARN("%s", warning.toString().c_str());
     const double loadSeconds = secondsSince(start);
     if (loadSeconds > kProgressQuietTime) {
       ROS_INFO("analysis: loaded %zu links and %zu connections (%.1f s)", valueOf(mechanism).links.size(),

@@ -207,6 +207,59 @@ void fromDofFields(const Response& response, MobilityReport& report) {
   report.warnings = response.warnings;
 }
 
+std::vector<StressedElement> toForceMessages(const std::vector<ElementForce>& forces) {
+  std::vector<StressedElement> out;
+  out.reserve(forces.size());
+  for (const ElementForce& f : forces) {
+    StressedElement m;
+    m.name = f.name;
+    m.kind = f.kind;
+    m.force = f.force;
+    out.push_back(m);
+  }
+  return out;
+}
+
+std::vector<ElementForce> fromForceMessages(const std::vector<StressedElement>& forces) {
+  std::vector<ElementForce> out;
+  out.reserve(forces.size());
+  for (const auto& f : forces)
+    out.push_back(ElementForce{f.name, f.kind, f.force});
+  return out;
+}
+
+void toSelfStressMessage(const SelfStressInfo& info, SelfStressSummary& message) {
+  message.count = info.count;
+  message.mechanism_modes = info.mechanismModes;
+  message.states_listed = info.statesListed;
+  message.states.clear();
+  for (const SelfStressState& state : info.states) {
+    StressState m;
+    m.elements = toForceMessages(state.elements);
+    message.states.push_back(m);
+  }
+  message.taut_cables = info.tautCables;
+  message.prestressable = info.prestressable;
+  message.prestress = toForceMessages(info.prestress);
+  message.prestress_stable = info.prestressStable;
+  message.stability = info.stability;
+}
+
+SelfStressInfo fromSelfStressMessage(const SelfStressSummary& message) {
+  SelfStressInfo info;
+  info.count = message.count;
+  info.mechanismModes = message.mechanism_modes;
+  info.statesListed = message.states_listed;
+  for (const auto& state : message.states)
+    info.states.push_back(SelfStressState{fromForceMessages(state.elements)});
+  info.tautCables = message.taut_cables;
+  info.prestressable = message.prestressable;
+  info.prestress = fromForceMessages(message.prestress);
+  info.prestressStable = message.prestress_stable;
+  info.stability = message.stability;
+  return info;
+}
+
 std::vector<ElementClassification> toStatusMessages(const std::vector<ElementStatus>& statuses) {
   std::vector<ElementClassification> out;
   out.reserve(statuses.size());
@@ -324,6 +377,7 @@ void toReportFields(const MobilityReport& report, Response& response) {
   response.characteristic_length = report.characteristicLength;
   response.closure_residual_before = report.closureResidualBefore;
   response.closure_residual_after = report.closureResidualAfter;
+  toSelfStressMessage(report.selfStress, response.self_stress);
 }
 
 template <class Response>
@@ -355,6 +409,7 @@ MobilityReport fromReportFields(const Response& response) {
   report.characteristicLength = response.characteristic_length;
   report.closureResidualBefore = response.closure_residual_before;
   report.closureResidualAfter = response.closure_residual_after;
+  report.selfStress = fromSelfStressMessage(response.self_stress);
   return report;
 }
 

@@ -41,6 +41,7 @@ constexpr double kWait = 30.0;  ///< Bound of every wait loop [s].
 
 struct Config {
   std::string urdfFile, modeText = "auto", server = "/mobility_server";
+  std::string closuresFile;  ///< ~closures of the launched node (a Gepetto closure file), empty: none.
   bool expectRedundant = false;
 };
 Config config;
@@ -52,9 +53,17 @@ std::string readFile(const std::string& path) {
   return buffer.str();
 }
 
+/// How the launched node reads its model: with its closure file, if any.
+ReadOptions readOptions() {
+  ReadOptions options;
+  options.closuresFile = config.closuresFile;
+  return options;
+}
+
 /// The report the core computes in-process for the launched model, as the node read it.
 MobilityReport expectedReport() {
-  const Result<Mechanism> mechanism = loadMechanismFromString(readFile(config.urdfFile), "robot_description");
+  const Result<Mechanism> mechanism =
+      readMechanismFromString(readFile(config.urdfFile), "robot_description", readOptions());
   EXPECT_TRUE(isOk(mechanism));
   AnalysisOptions options;
   options.mode = valueOf(parseAnalysisMode(config.modeText));
@@ -63,7 +72,7 @@ MobilityReport expectedReport() {
   return valueOf(analysis).report;
 }
 
-Mechanism launchedMechanism() { return valueOf(loadMechanismFromFile(config.urdfFile)); }
+Mechanism launchedMechanism() { return valueOf(readMechanism(config.urdfFile, readOptions())); }
 
 int transportRetries = 0;  ///< Non-persistent calls that had to be repeated (see call()).
 
@@ -234,11 +243,12 @@ TEST(MobilityServer, servicesAnswerLikeTheCoreAndTheCli) {
     ADD_FAILURE() << "CLI " << MA_REPORT_EXE << " not built";
     return;
   }
+  const std::string closures = config.closuresFile.empty() ? "" : " --closures '" + config.closuresFile + "'";
   const auto [json, status] = run(std::string(MA_REPORT_EXE) + " '" + config.urdfFile + "' --mode " +
-                                  config.modeText + " --json");
+                                  config.modeText + closures + " --json");
   ASSERT_EQ(status, 0) << json;
   MobilityReport fromService = fromResponse(redundancy.response);
-  fromService.file = valueOf(loadMechanismFromFile(config.urdfFile)).file;
+  fromService.file = launchedMechanism().file;
   EXPECT_EQ(toJson(fromService), json);
 }
 
@@ -575,6 +585,7 @@ int main(int argc, char** argv) {
   privateHandle.getParam("mode", config.modeText);
   privateHandle.getParam("expect_redundant", config.expectRedundant);
   privateHandle.getParam("server", config.server);
+  privateHandle.getParam("closures", config.closuresFile);
   ros::AsyncSpinner spinner(1);  // tf listeners and marker subscribers get their callbacks while tests wait
   spinner.start();
   return RUN_ALL_TESTS();

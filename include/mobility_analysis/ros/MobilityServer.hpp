@@ -104,6 +104,7 @@ class MobilityServer {
   bool publishLinkTf_ = true;
   bool animate_ = false;
   std::string fixedFrame_ = "mobility_world";
+  std::string closuresFile_;  ///< ~closures: a Pinocchio/Gepetto closure file for a tree-only URDF; empty: none.
 
   mutable std::mutex stateMutex_;  ///< Guards served_ and loadError_ (held only to copy or swap them).
   StatePtr served_;
