@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include "core/CliRun.hpp"
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
@@ -150,32 +151,6 @@ TEST(Deployment, JsonReportsTheSteps) {
   EXPECT_NE(json.find("\"final_length\": 0.707106781"), std::string::npos);
   EXPECT_EQ(json.find("nan"), std::string::npos);
 }
-
-namespace {
-
-struct CliRun {
-  int status;
-  std::string out, err;
-};
-
-CliRun runReport(const std::string& arguments) {
-  const std::string errFile = ::testing::TempDir() + "deployment_cli_stderr.txt";
-  const std::string command = std::string(MA_REPORT_EXE) + " " + arguments + " 2>" + errFile;
-  CliRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    run.out.append(buffer.data(), n);
-  run.status = WEXITSTATUS(pclose(pipe));
-  std::ifstream err(errFile);
-  std::stringstream text;
-  text << err.rdbuf();
-  run.err = text.str();
-  return run;
-}
-
-}  // namespace
 
 TEST(DeploymentCli, DeployAndLockFlags) {
   const CliRun deploy =

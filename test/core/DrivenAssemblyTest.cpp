@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include "core/CliRun.hpp"
 #include "core/TestModels.hpp"
 
 using namespace mobility_analysis;
@@ -298,32 +299,6 @@ TEST(DrivenAssembly, PeaucellierDrivenTwentyDegreesStaysAnInversor) {
   ASSERT_NE(at, std::string::npos) << what;
   EXPECT_NEAR(std::strtod(what.c_str() + at + 9, nullptr), 2.0 * std::acos(0.75) - M_PI / 6.0, 1e-4) << what;
 }
-
-namespace {
-
-struct CliRun {
-  int status;
-  std::string out, err;
-};
-
-CliRun runReport(const std::string& arguments) {
-  const std::string errFile = ::testing::TempDir() + "driven_mobility_report_stderr.txt";
-  const std::string command = std::string(MA_REPORT_EXE) + " " + arguments + " 2>" + errFile;
-  CliRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    run.out.append(buffer.data(), n);
-  run.status = WEXITSTATUS(pclose(pipe));
-  std::ifstream err(errFile);
-  std::stringstream text;
-  text << err.rdbuf();
-  run.err = text.str();
-  return run;
-}
-
-}  // namespace
 
 TEST(DrivenAssemblyCli, TextReportSaysWhereItEndedAndUnreachableValuesExitTwo) {
   const CliRun moved = runReport(motionFixture("crank_rocker.urdf") + " --positions j1=2");

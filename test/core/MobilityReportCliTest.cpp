@@ -9,32 +9,12 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include "core/CliRun.hpp"
 #include "core/TestModels.hpp"
 
 using namespace mobility_analysis;
 
 namespace {
-
-struct CliRun {
-  int status;
-  std::string out, err;
-};
-
-CliRun runReport(const std::string& arguments) {
-  const std::string errFile = ::testing::TempDir() + "mobility_report_stderr.txt";
-  const std::string command = std::string(MA_REPORT_EXE) + " " + arguments + " 2>" + errFile;
-  CliRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
-  run.status = WEXITSTATUS(pclose(pipe));
-  std::ifstream err(errFile);
-  std::stringstream text;
-  text << err.rdbuf();
-  run.err = text.str();
-  return run;
-}
 
 std::string readTextFile(const std::string& path) {
   std::ifstream in(path);
@@ -168,14 +148,7 @@ TEST(MobilityReportCli, AChainOfTwoHundredThousandLinksReportsItsDof) {
   // urdfdom walked the tree recursively and crashed past ~130 000 links; the reader is iterative and a tree is
   // eliminated from its leaves, so the whole report stays linear.
   constexpr int kLinks = 200000;
-  std::string text = "<robot name='chain'><link name='l0'/>";
-  text.reserve(static_cast<size_t>(kLinks) * 160);
-  for (int i = 1; i <= kLinks; ++i) {
-    const std::string n = std::to_string(i), p = std::to_string(i - 1);
-    text += "<link name='l" + n + "'/><joint name='j" + n + "' type='revolute'><parent link='l" + p +
-            "'/><child link='l" + n + "'/><origin xyz='0.1 0 0'/><axis xyz='0 0 1'/></joint>";
-  }
-  text += "</robot>";
+  const std::string text = straightChainUrdf(kLinks);
   const CliRun run = runReport(writeFile("chain.urdf", text) + " --json");
   EXPECT_EQ(run.status, 0) << run.err;
   EXPECT_EQ(jsonInt(run.out, "dof"), kLinks);

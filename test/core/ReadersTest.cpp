@@ -575,14 +575,7 @@ TEST(Numbers, TheJsonWriterRefusesInfAndNanAndNeverWritesThem) {
 
 TEST(DeepTrees, AChainOfTwoHundredThousandLinksLoads) {
   constexpr int kLinks = 200000;
-  std::string text = "<robot name='chain'><link name='l0'/>";
-  text.reserve(static_cast<size_t>(kLinks) * 160);
-  for (int i = 1; i <= kLinks; ++i) {
-    const std::string n = std::to_string(i), p = std::to_string(i - 1);
-    text += "<link name='l" + n + "'/><joint name='j" + n + "' type='revolute'><parent link='l" + p +
-            "'/><child link='l" + n + "'/><origin xyz='0.1 0 0'/><axis xyz='0 0 1'/></joint>";
-  }
-  text += "</robot>";
+  const std::string text = straightChainUrdf(kLinks);
   const Result<Mechanism> m = readMechanismFromString(text, "chain.urdf");
   ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
   EXPECT_EQ(valueOf(m).links.size(), static_cast<size_t>(kLinks + 1));

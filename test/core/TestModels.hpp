@@ -34,6 +34,18 @@ inline MobilityAnalysis analyzeOrFail(const std::string& path, AnalysisMode mode
   return valueOf(std::move(analysis));
 }
 
+/// A straight chain of @p links revolute joints about z, 0.1 m apart: DOF @p links in the plane and in space.
+inline std::string straightChainUrdf(int links) {
+  std::string text = "<robot name='chain'><link name='l0'/>";
+  text.reserve(static_cast<size_t>(links) * 160);
+  for (int i = 1; i <= links; ++i) {
+    const std::string n = std::to_string(i), p = std::to_string(i - 1);
+    text += "<link name='l" + n + "'/><joint name='j" + n + "' type='revolute'><parent link='l" + p +
+            "'/><child link='l" + n + "'/><origin xyz='0.1 0 0'/><axis xyz='0 0 1'/></joint>";
+  }
+  return text + "</robot>";
+}
+
 /// A URDF with one joint of every kind the dialect knows; its loops need not close (Jacobian tests).
 inline const char* allJointKindsUrdf() {
   return R"(<robot name="all_kinds">
