@@ -233,6 +233,23 @@ TEST(Couplings, HoldTheFollowerAtMultiplierTimesTheLeaderPlusOffset) {
   }
 }
 
+TEST(Couplings, HoldWhenEitherJointIsDriven) {
+  // b = -a + 0.1: drive the leader and the follower follows, drive the follower and the leader does.
+  const Mechanism gripper = readOrFail(formatPath("gripper_revolute_mimic.urdf"));
+  for (const auto& [driven, value] : {std::pair<std::string, double>{"a", 0.4}, {"b", -0.5}}) {
+    SCOPED_TRACE(driven);
+    AnalysisOptions options;
+    options.positions = {{driven, value}};
+    const Result<MobilityAnalysis> analysis = analyzeMechanism(gripper, options);
+    ASSERT_TRUE(isOk(analysis)) << diagnosticOf(analysis).toString();
+    const std::vector<JointValue>& reached = valueOf(analysis).report.positions;
+    ASSERT_EQ(reached.size(), 2u);
+    EXPECT_NEAR(reached[driven == "a" ? 0 : 1].value, value, 1e-9) << "the driven joint is held";
+    EXPECT_NEAR(reached[1].value, -reached[0].value + 0.1, 1e-9) << "the coupling holds";
+    EXPECT_EQ(valueOf(analysis).report.dof, 1);
+  }
+}
+
 TEST(Couplings, TakePartInTheOrderedRedundancyAfterTheLoopJoints) {
   // The same gear ratio said twice (a mimic and a URDF+ coupling): the second equation, the <coupling>, is
   // the redundant one, reported with its own source kind.
