@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <initializer_list>
 #include <set>
 #include <unordered_map>
 #include <unordered_set>
@@ -45,38 +46,26 @@ std::string squashed(const std::string& name) {
 
 const char* loopTypeList = "revolute, continuous, prismatic, cylindrical, spherical, universal, fixed";
 
-std::optional<JointType> parseLoopType(const std::string& type) {
-  if (type == "revolute")
-    return JointType::Revolute;
-  if (type == "continuous")
-    return JointType::Continuous;
-  if (type == "prismatic")
-    return JointType::Prismatic;
-  if (type == "cylindrical")
-    return JointType::Cylindrical;
-  if (type == "spherical")
-    return JointType::Spherical;
-  if (type == "universal")
-    return JointType::Universal;
-  if (type == "fixed")
-    return JointType::Fixed;
+/// The type spelled @p type among @p allowed, by the dialect's spelling (toString(JointType)).
+std::optional<JointType> parseJointType(const std::string& type, std::initializer_list<JointType> allowed) {
+  for (const JointType candidate : allowed) {
+    if (type == toString(candidate))
+      return candidate;
+  }
   return std::nullopt;
 }
 
+/// Loop elements take every type of the dialect but the URDF tree's own planar and floating.
+std::optional<JointType> parseLoopType(const std::string& type) {
+  return parseJointType(type, {JointType::Revolute, JointType::Continuous, JointType::Prismatic,
+                               JointType::Cylindrical, JointType::Spherical, JointType::Universal,
+                               JointType::Fixed});
+}
+
+/// Tree joints take URDF's types.
 std::optional<JointType> parseTreeType(const std::string& type) {
-  if (type == "revolute")
-    return JointType::Revolute;
-  if (type == "continuous")
-    return JointType::Continuous;
-  if (type == "prismatic")
-    return JointType::Prismatic;
-  if (type == "fixed")
-    return JointType::Fixed;
-  if (type == "floating")
-    return JointType::Floating;
-  if (type == "planar")
-    return JointType::Planar;
-  return std::nullopt;
+  return parseJointType(type, {JointType::Revolute, JointType::Continuous, JointType::Prismatic,
+                               JointType::Fixed, JointType::Floating, JointType::Planar});
 }
 
 bool needsAxis(JointType type) {
