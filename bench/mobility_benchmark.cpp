@@ -10,9 +10,16 @@
 /// finite:  the finite-mobility test (second-order test, step-and-project) and the passive-freedom search, timed
 ///          next to the plain first-order core they follow (Jacobian, self-stress basis, ordered rank); the line
 ///          has finite_dof, passive_dof, plain_seconds, finite_seconds, passive_seconds and ratio = all / plain.
+/// spqr:    one SuiteSparse SPQR rank-revealing sparse QR (Eigen::SPQR, SPQR's default tolerance) of the same
+///          row-normalised Jacobian: the floor for any sparse rank answer (counts only); built when SuiteSparse
+///          is found;
+/// parse:   the bare XML parse of the file (tinyxml2::XMLDocument::LoadFile), nothing else: the floor of loading;
+/// slvs:    SolveSpace's solver (libslvs) on the planar bar-and-pin models it can express (SolveSpacePeer.hpp):
+///          one Slvs_Solve, its dof; built only when libslvs is found (status=unsupported otherwise).
 /// Peak memory is the process's maximum resident set (getrusage), so run one method per process.
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -20,6 +27,13 @@
 
 #include <Eigen/Dense>
 #include <sys/resource.h>
+#include <tinyxml2.h>
+#ifdef MA_HAVE_SPQR
+#include <Eigen/SPQRSupport>
+#endif
+#ifdef MA_HAVE_SLVS
+#include "SolveSpacePeer.hpp"
+#endif
 
 #include "mobility_analysis/analysis/FiniteMobility.hpp"
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
@@ -34,6 +48,9 @@ double peakMegabytes() {
   getrusage(RUSAGE_SELF, &usage);
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
+
+constexpr const char* kUsage =
+    "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|slvs FILE.urdf [--mode M] [--budget S]";
 
 int fail(const std::string& line) {
   std::cerr << line << std::endl;
@@ -55,14 +72,27 @@ int main(int argc, char** argv) {
     } else if (file.empty() && arg[0] != '-') {
       file = arg;
     } else {
-      return fail("usage: mobility_benchmark --method full|finite|literal|dense FILE.urdf [--mode M] [--budget S]");
+      return fail(kUsage);
     }
   }
-  if (file.empty() || (method != "full" && method != "finite" && method != "literal" && method != "dense")) {
-    return fail("usage: mobility_benchmark --method full|finite|literal|dense FILE.urdf [--mode M] [--budget S]");
+  if (file.empty() || (method != "full" && method != "finite" && method != "literal" && method != "dense" &&
+                       method != "spqr" && method != "parse" && method != "slvs")) {
+    return fail(kUsage);
   }
   const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
   if (!isOk(mode)) return fail(diagnosticOf(mode).toString());
+  if (method == "parse") {
+    // The floor of loading: one tinyxml2 parse of the file into a DOM, as the URDF reader's first step.
+    const auto parseStart = std::chrono::steady_clock::now();
+    tinyxml2::XMLDocument document;
+    const tinyxml2::XMLError error = document.LoadFile(file.c_str());
+    const double parseSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - parseStart).count();
+    if (error != tinyxml2::XML_SUCCESS) return fail(file + ": " + document.ErrorStr());
+    std::printf("method=parse file=%s coordinates=-1 equations=-1 dof=-1 redundant=-1 seconds=%.4f peak_mb=%.1f status=ok\n",
+                file.c_str(), parseSeconds, peakMegabytes());
+    return 0;
+  }
   // The clock starts before the file is read: "full" is what `mobility_report --json` does, end to end.
   const auto start = std::chrono::steady_clock::now();
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
@@ -116,6 +146,57 @@ int main(int argc, char** argv) {
         plainSeconds, finiteSeconds, passiveSeconds, (plainSeconds + finiteSeconds + passiveSeconds) / plainSeconds,
         finite.steppedAndProjected ? 1 : 0, peakMegabytes());
     return 0;
+  } else if (method == "slvs") {
+#ifdef MA_HAVE_SLVS
+    const bench::SolveSpaceResult slvs =
+        bench::solveWithSolveSpace(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), false);
+    std::printf("method=slvs file=%s coordinates=%d equations=%d dof=%d redundant=-1 seconds=%.4f peak_mb=%.1f status=%s\n",
+                file.c_str(), slvs.parameters, slvs.constraints, slvs.status == "ok" ? slvs.dof : -1,
+                slvs.solveSeconds, peakMegabytes(), slvs.status.substr(0, slvs.status.find(':')).c_str());
+    if (slvs.status.rfind("unsupported", 0) == 0) std::cerr << slvs.status << std::endl;
+#else
+    std::printf("method=slvs file=%s coordinates=-1 equations=-1 dof=-1 redundant=-1 seconds=0 peak_mb=%.1f "
+                "status=unsupported\n", file.c_str(), peakMegabytes());
+    std::cerr << "mobility_benchmark was built without libslvs (libslvs1-dev)" << std::endl;
+#endif
+    return 0;
+  } else if (method == "spqr") {
+    // One sparse rank-revealing QR of the same Jacobian the full report ranks, built and row-normalised outside
+    // the timed region (as for dense): the lower bound for any sparse rank answer.
+    const Result<AssembledMechanism> assembled =
+        assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
+    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
+    SparseJacobian J = computeConstraintJacobian(valueOf(assembled).model, valueOf(assembled).q);
+    n = static_cast<int>(J.cols());
+    m = static_cast<int>(J.rows());
+#ifdef MA_HAVE_SPQR
+    Eigen::SparseMatrix<double, Eigen::RowMajor> rows(J);
+    for (int r = 0; r < m; ++r) {
+      double norm = 0;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, r); it; ++it) norm += it.value() * it.value();
+      norm = std::sqrt(norm);
+      if (norm == 0) continue;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, r); it; ++it) it.valueRef() /= norm;
+    }
+    Eigen::SparseMatrix<double, Eigen::ColMajor> A(rows);
+    A.makeCompressed();
+    const auto timed = std::chrono::steady_clock::now();
+    Eigen::SPQR<Eigen::SparseMatrix<double, Eigen::ColMajor>> qr;
+    qr.compute(A);
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - timed).count();
+    if (qr.info() != Eigen::Success) {
+      status = "failed";
+    } else {
+      dof = n - static_cast<int>(qr.rank());
+      redundant = m - static_cast<int>(qr.rank());
+    }
+    std::printf("method=spqr file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f peak_mb=%.1f status=%s\n",
+                file.c_str(), n, m, dof, redundant, elapsed, peakMegabytes(), status.c_str());
+    return 0;
+#else
+    status = "unsupported";
+    std::cerr << "mobility_benchmark was built without SuiteSparse SPQR" << std::endl;
+#endif
   } else {
     // The same Jacobian the full report uses, built outside the timed region for the baselines.
     const Result<AssembledMechanism> assembled =
