@@ -35,9 +35,9 @@ constexpr double kDashLength = 0.03;
 constexpr int kMaxDashes = 100;
 /// Width of a cable's line [link widths] (a distance constraint keeps 0.5).
 constexpr double kCableWidth = 0.6;
-/// Width of an element in ns `forces`: (kForceWidth + kForceWidthGain |force|) link widths.
-constexpr double kForceWidth = 0.8;
-constexpr double kForceWidthGain = 1.2;
+/// Width of an element in ns `forces`: (kForceWidth + kForceWidthGain sqrt|force|) link widths.
+constexpr double kForceWidth = 1.0;
+constexpr double kForceWidthGain = 2.0;
 
 std_msgs::ColorRGBA makeColor(float r, float g, float b) {
   std_msgs::ColorRGBA color;
@@ -410,7 +410,8 @@ std::vector<visualization_msgs::Marker> toForceMarkers(const Mechanism& mechanis
   Marker legend =
       makeMarker(frame, stamp, kForcesNamespace, 0, Marker::TEXT_VIEW_FACING, makeColor(1.0f, 1.0f, 1.0f));
   Eigen::Vector3d at = 0.5 * (bounds.lower + bounds.upper);
-  at += (bounds.lower.dot(bounds.up) - at.dot(bounds.up) - 2.5 * kTitleHeight * scale) * bounds.up;
+  // Below the model and the labels that part downwards beneath it.
+  at += (bounds.lower.dot(bounds.up) - at.dot(bounds.up) - 7.0 * kTitleHeight * scale) * bounds.up;
   legend.pose.position = toPoint(at);
   legend.scale.x = legend.scale.y = legend.scale.z = 0.8 * kTitleHeight * scale;
   legend.text = "forces: " + selection.title;
@@ -422,7 +423,7 @@ std::vector<visualization_msgs::Marker> toForceMarkers(const Mechanism& mechanis
     const bool isSigned = f.kind == "cable" || f.kind == "distance_constraint";
     const std_msgs::ColorRGBA color = toForceColor(f.force, isSigned);
     const double width =
-        (kForceWidth + kForceWidthGain * std::min(1.0, std::abs(f.force))) * kLinkWidth * scale;
+        (kForceWidth + kForceWidthGain * std::sqrt(std::min(1.0, std::abs(f.force)))) * kLinkWidth * scale;
     if (f.kind == "link" || f.kind == "boundary") {
       const std::optional<int> l = mechanism.findLink(f.name);
       if (!l)
@@ -463,7 +464,11 @@ std::vector<visualization_msgs::Marker> toForceMarkers(const Mechanism& mechanis
     if (isSigned && (p1 - p2).norm() > kSamePoint * scale) {
       m.type = Marker::LINE_LIST;
       m.scale.x = m.scale.y = m.scale.z = width;
-      m.points = {toPoint(p1), toPoint(p2)};
+      // A model lying flat is seen from above: its cables a little above the plane, so one that runs along a
+      // bar (a base cable along the ground) is not hidden under the bar's colour.
+      const Eigen::Vector3d lift =
+          bounds.up.z() == 0.0 ? Eigen::Vector3d(0.0, 0.0, 2.0 * kLinkWidth * scale) : Eigen::Vector3d::Zero();
+      m.points = {toPoint(p1 + lift), toPoint(p2 + lift)};
     } else {
       m.pose.position = toPoint(p2);
       m.scale.x = m.scale.y = m.scale.z =

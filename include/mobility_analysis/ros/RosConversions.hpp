@@ -84,7 +84,7 @@ ForcesSelection selectForces(const SelfStressInfo& info, int choice);
 
 /**
  * @brief Markers of ns `forces`: every element that carries the chosen forces (selectForces) drawn over its
- *        ordinary marker, coloured by toForceColor and as wide as 0.8 + 1.2 |force| times the link width
+ *        ordinary marker, coloured by toForceColor and as wide as 1 + 2 sqrt|force| link widths
  *        (links, boundaries: their lines, or a sphere for a one-point link; joints: a sphere at the joint;
  *        cables and distance constraints: their line), plus a legend (id 0, TEXT_VIEW_FACING) below the
  * model. Ids: 0 legend, 1 + link index, 1 + links + connection index, 1 + links + connections + link index
