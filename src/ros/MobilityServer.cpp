@@ -503,7 +503,8 @@ bool MobilityServer::deploy(Deploy::Request& request, Deploy::Response& response
     options.cable = request.cable;
     options.steps = steps;
     options.targetLength = request.target_length;
-    options.analysis = makeOptions(start->mode, {}, loadTimeout_);
+    // The final analysis may take ~load_timeout beyond the paced steps.
+    options.analysis = makeOptions(start->mode, {}, loadTimeout_ + request.duration);
     options.analysis.startPoses = start->analysis.assembled.poses;  // From the state in force.
     options.analysis.lockActiveCables = request.lock_active_cables;
     // Each step is shown through the one publishing path (commit): a display state that carries the start's
@@ -555,7 +556,13 @@ bool MobilityServer::deploy(Deploy::Request& request, Deploy::Response& response
     if (!isOk(result)) {
       toFailure(diagnosticOf(result), response);
       response.steps = published;
-      ROS_WARN("deploy: %s (%d states published; the last one stays)", response.message.c_str(), published);
+      if (published > 0) {
+        // The steps shown carried the start's report: the start, fully analysed, is served again.
+        std::lock_guard<std::mutex> motion(motionMutex_);
+        if (commit(start, ros::Time::now()))
+          response.message += " (the start state is served again)";
+      }
+      ROS_WARN("deploy: %s (%d states were shown)", response.message.c_str(), published);
       return;
     }
     MobilityAnalysis analysis = valueOf(std::move(result));
