@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "mobility_analysis/Deploy.h"
@@ -47,6 +48,15 @@ class Recorder {
                                                       std::lock_guard<std::mutex> lock(mutex_);
                                                       joints_.push_back(*m);
                                                     });
+    // Both servers of the launch file publish /tf_static (the frames of their own mast): count this one's by
+    // its deployment's stamps, later than the subscription.
+    tf_ = nh.subscribe<tf2_msgs::TFMessage>("/tf_static", 1000, [this](const tf2_msgs::TFMessageConstPtr& m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const auto& t : m->transforms) {
+        if (t.child_frame_id == "bar_4_b")
+          topFrames_.push_back(t);
+      }
+    });
     markers_ = nh.subscribe<visualization_msgs::MarkerArray>(
         ns + "/mobility_server/markers", 1000, [this](const visualization_msgs::MarkerArrayConstPtr& m) {
           std::lock_guard<std::mutex> lock(mutex_);
@@ -64,6 +74,10 @@ class Recorder {
   std::vector<sensor_msgs::JointState> joints() {
     std::lock_guard<std::mutex> lock(mutex_);
     return joints_;
+  }
+  std::vector<geometry_msgs::TransformStamped> topFrames() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return topFrames_;
   }
   std::vector<visualization_msgs::MarkerArray> arrays() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -88,7 +102,9 @@ class Recorder {
   std::mutex mutex_;
   std::vector<sensor_msgs::JointState> joints_;
   std::vector<visualization_msgs::MarkerArray> arrays_;
+  std::vector<geometry_msgs::TransformStamped> topFrames_;
   ros::Subscriber states_;
+  ros::Subscriber tf_;
   ros::Subscriber markers_;
 };
 
@@ -155,6 +171,7 @@ TEST(MobilityDeploy, theMastDeploysUntilItsPassiveCablesGoTautAndStaysDeployed) 
       EXPECT_EQ(c.state, "slack") << c.name;
   }
 
+  const ros::Time deployStart = ros::Time::now();
   Deploy deploy;
   deploy.request.cable = "active_base";
   deploy.request.steps = 100;     // 0.00985 m each: the cables go taut in the 29th
@@ -227,6 +244,18 @@ TEST(MobilityDeploy, theMastDeploysUntilItsPassiveCablesGoTautAndStaysDeployed) 
   EXPECT_NEAR(std::abs(series.at("base_slide").back()), std::cos(kBeta0) - std::cos(kDeployed), 1e-7);
   EXPECT_NEAR(std::abs(series.at("left_pin_4").back()), 2.0 * (kDeployed - kBeta0), 1e-7);
   EXPECT_NEAR(series.at("base_pin").front(), 0.0, 1e-9) << "it started folded";
+
+  // tf per step: the top unit's frame, once per published state, rising with the mast.
+  std::vector<double> rise;
+  for (const auto& t : recorder.topFrames()) {
+    if (t.header.stamp >= deployStart)
+      rise.push_back(t.transform.translation.y);
+  }
+  EXPECT_GE(rise.size(), static_cast<size_t>(r.steps)) << "tf of every state";
+  for (size_t i = 1; i < rise.size(); ++i)
+    EXPECT_GE(rise[i], rise[i - 1] - 1e-9) << "the top unit only rises";
+  ASSERT_FALSE(rise.empty());
+  EXPECT_GT(rise.back(), rise.front() + 0.1);
 
   // Markers: every array is one pose, slack cables dashed and taut ones solid at that pose, the base cable as
   // long as that pose's closed form; the first slack, the last taut.
