@@ -485,6 +485,11 @@ bool MobilityServer::move(Move::Request& request, Move::Response& response) {
 bool MobilityServer::deploy(Deploy::Request& request, Deploy::Response& response) {
   return guarded("deploy", response, [&] {
     response.success = false;
+    std::unique_lock<std::mutex> deploying(deployMutex_, std::try_to_lock);
+    if (!deploying.owns_lock()) {
+      response.message = "deploy: another deployment is running; refused";
+      return;
+    }
     const StatePtr start = current();
     if (!start) {
       response.message = "deploy: no model loaded";

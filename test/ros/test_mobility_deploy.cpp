@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -176,7 +177,14 @@ TEST(MobilityDeploy, theMastDeploysUntilItsPassiveCablesGoTautAndStaysDeployed) 
   deploy.request.cable = "active_base";
   deploy.request.steps = 100;     // 0.00985 m each: the cables go taut in the 29th
   deploy.request.duration = 3.0;  // 33 states a second: rviz (and this test) sees every one
-  ASSERT_TRUE(ros::service::call(server + "/deploy", deploy));
+  auto running =
+      std::async(std::launch::async, [&] { return ros::service::call(server + "/deploy", deploy); });
+  ros::WallDuration(0.5).sleep();  // the first one is on its way (3 s)
+  Deploy second = deploy;
+  ASSERT_TRUE(ros::service::call(server + "/deploy", second));
+  EXPECT_FALSE(second.response.success) << "one deployment at a time";
+  EXPECT_NE(second.response.message.find("another deployment"), std::string::npos) << second.response.message;
+  ASSERT_TRUE(running.get());
   const auto& r = deploy.response;
   ASSERT_TRUE(r.success) << r.message;
   EXPECT_EQ(r.cable, "active_base");

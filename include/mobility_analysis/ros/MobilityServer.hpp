@@ -122,6 +122,7 @@ class MobilityServer {
   std::string loadError_;   ///< Why nothing is served (robot_description missing or bad).
   std::mutex loadMutex_;    ///< One ~load_robot at a time.
   std::mutex motionMutex_;  ///< One state change (joint states, ~move, animation, swap) at a time.
+  std::mutex deployMutex_;  ///< One ~deploy at a time (another is refused, not queued).
   std::atomic<uint64_t> generation_{0};
   bool unreachableLogged_ = false;  ///< An unreachable input was logged in this episode (motionMutex_).
   std::atomic<double> lastInputTime_{0.0};
