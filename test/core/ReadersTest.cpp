@@ -427,8 +427,14 @@ TEST(Warnings, EveryClassFiresAndNamesItsElement) {
   <joint name="jb" type="continuous"><parent link="g"/><child link="b"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
   <loop name="l" type="spherical"><predecessor link="a"/><successor link="b"/><successor link="g"/><damping/></loop>
   <coupling name="c"><predecessor joint="ja"/><successor joint="jb"/><ratio value="2"/><backlash/></coupling>
+  <link name="d"/><joint name="jd" type="prismatic"><parent link="a"/><child link="d"/></joint>
+  <loop name="hinge" type="revolute"><predecessor link="d"/><successor link="b"/></loop>
 </robot>)";
   const std::vector<std::string> wp = warningTexts(valueOf(readMechanismFromString(plus, "p.urdf")));
+  // A forgotten axis, on a tree joint or a loop whose type needs one: URDF's 1 0 0, said.
+  EXPECT_TRUE(anyContains(wp, "joint 'jd'", "type prismatic has no <axis>; axis defaulted to 1 0 0"));
+  EXPECT_TRUE(anyContains(wp, "loop 'hinge'", "type revolute has no <axis>; axis defaulted to 1 0 0"));
+  EXPECT_FALSE(anyContains(wp, "loop 'l'", "axis")) << "a spherical loop needs no axis";
   EXPECT_TRUE(anyContains(wp, "loop 'l'", "more than one <successor>"));
   EXPECT_TRUE(anyContains(wp, "loop 'l'", "unknown child <damping>"));
   EXPECT_TRUE(anyContains(wp, "coupling 'c'", "unknown child <backlash>"));
@@ -857,4 +863,21 @@ TEST(SdfReader, TheFrontDoorKnowsSdfByItsRootOrItsExtension) {
   EXPECT_NE(diagnosticOf(bad).toString().find("empty.sdf"), std::string::npos);
   EXPECT_NE(diagnosticOf(bad).toString().find("libsdformat"), std::string::npos)
       << diagnosticOf(bad).toString();
+}
+
+TEST(Warnings, AMisspeltLoopInMjcfOrAClosureFileIsNeverAnOpenTree) {
+  // MJCF: MuJoCo's schema refuses <conect> (exit 2), so the leg is never read without its plantar loop.
+  std::string mjcf = readText(formatPath("cassie_leg_mjcf.xml"));
+  mjcf = std::regex_replace(mjcf, std::regex("<connect name=\"plantar\""), "<conect name=\"plantar\"");
+  const Result<Mechanism> m = readMechanismFromString(mjcf, "leg.xml");
+  ASSERT_FALSE(isOk(m));
+  EXPECT_NE(diagnosticOf(m).what.find("conect"), std::string::npos) << diagnosticOf(m).toString();
+  expectOneLine(diagnosticOf(m).toString());
+  // Closure file: 'closed_loops' is not the key, and a closure file without closed_loop is refused.
+  ReadOptions options;
+  options.closuresFile = writeTemp("typo.yaml", "closed_loops: [['closure_A', 'closure_B']]\ntype: ['6d']\n");
+  const Result<Mechanism> y = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
+  ASSERT_FALSE(isOk(y));
+  EXPECT_NE(diagnosticOf(y).toString().find("'closed_loop': is missing"), std::string::npos)
+      << diagnosticOf(y).toString();
 }
