@@ -117,8 +117,7 @@ Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const LinkPoses& pos
 std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const LinkPoses& poses) {
   for (const Joint& joint : mechanism.joints) {
     if (joint.kind != ConnectionKind::DistanceConstraint && joint.kind != ConnectionKind::Cable &&
-        joint.kind != ConnectionKind::Coupling &&
-        isSpatialOnly(joint.type)) {
+        joint.kind != ConnectionKind::Coupling && isSpatialOnly(joint.type)) {
       return std::nullopt;
     }
   }
@@ -131,6 +130,17 @@ std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const
     if (classifyPlanar(joint, axes.first, axes.second, normal) == PlanarForm::Invalid) {
       return std::nullopt;
     }
+  }
+  // A distance constraint or cable carries no axis, so the test above says nothing about it: one that leaves
+  // the plane (a truss mast's longeron) makes the model spatial, else a model of distance constraints alone
+  // would be called planar whatever its shape.
+  for (const Joint& joint : mechanism.joints) {
+    if (joint.kind != ConnectionKind::DistanceConstraint && joint.kind != ConnectionKind::Cable)
+      continue;
+    const Eigen::Vector3d span =
+        poses[joint.link1] * joint.frame1.translation() - poses[joint.link2] * joint.frame2.translation();
+    if (std::abs(span.dot(normal)) > tolerances::kPlanarAxis * span.norm())
+      return std::nullopt;
   }
   return normal;
 }
@@ -237,8 +247,9 @@ LinkPoses recoverPoses(const CoordinateModel& model, const Eigen::Ref<const Eige
       const Eigen::Vector3d singular = svd.singularValues();
       if (singular(1) < 1e-9 * singular(0)) {
         const Eigen::Vector3d referenceLine = reference[b].linear() * svd.matrixU().col(0);
-        rotation = Eigen::Quaterniond::FromTwoVectors(referenceLine, svd.matrixV().col(0)).toRotationMatrix() *
-                   reference[b].linear();
+        rotation =
+            Eigen::Quaterniond::FromTwoVectors(referenceLine, svd.matrixV().col(0)).toRotationMatrix() *
+            reference[b].linear();
       }
     }
     poses[b].linear() = rotation;

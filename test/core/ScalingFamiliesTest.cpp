@@ -196,3 +196,23 @@ TEST(ScalingFamilies, ClosedFormsHoldAtAThousandUnits) {
     EXPECT_EQ(report.selfStress.count, c.dof - c.grubler);
   }
 }
+
+TEST(ScalingFamilies, AutoModeSeesATrussMastOfDistanceConstraintsAsSpatial) {
+  // The truss mast has no joint axis at all, so only its distance constraints can tell the plane test that its
+  // longerons leave every plane; the braced lattice's cables lie in the plane and stay planar.
+  const auto modeOf = [](const MechanismDescription& description) {
+    const GeneratorResult<std::string> urdf = toClosedLoopUrdf(description);
+    EXPECT_TRUE(std::holds_alternative<std::string>(urdf));
+    const Result<Mechanism> mechanism = loadMechanismFromString(std::get<std::string>(urdf), "auto.urdf");
+    EXPECT_TRUE(isOk(mechanism));
+    const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), AnalysisOptions{});
+    EXPECT_TRUE(isOk(analysis));
+    return std::pair{valueOf(analysis).report.mode, valueOf(analysis).report.dof};
+  };
+  const auto truss = modeOf(makeTrussMast(3));
+  EXPECT_EQ(truss.first, "spatial");
+  EXPECT_EQ(truss.second, 0);
+  const auto braced = modeOf(makeBarLattice(3, 4, true));
+  EXPECT_EQ(braced.first, "planar");
+  EXPECT_EQ(braced.second, 0);
+}
