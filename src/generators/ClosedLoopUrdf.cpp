@@ -384,7 +384,16 @@ void writeLayout(const MechanismDescription& mechanism, const ClosedLoopLayout& 
     }
     flush(false);
   }
+  std::vector<const TreeJointLayout*> treeJoints;
+  treeJoints.reserve(layout.treeJoints.size());
   for (const TreeJointLayout& joint : layout.treeJoints) {
+    treeJoints.push_back(&joint);
+  }
+  if (mechanism.treeJointsLeafFirst) {
+    std::reverse(treeJoints.begin(), treeJoints.end());
+  }
+  for (const TreeJointLayout* jointPointer : treeJoints) {
+    const TreeJointLayout& joint = *jointPointer;
     chunk += "  <joint name=\"" + joint.name + "\" type=\"" + joint.type + "\">\n    <parent link=\"" +
              joint.parent + "\"/>\n    <child link=\"" + joint.child + "\"/>\n    <origin ";
     appendPose(chunk, joint.origin);

@@ -2,6 +2,7 @@
 
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
 #include "mobility_analysis/generators/ReferenceMechanisms.hpp"
+#include "mobility_analysis/generators/ScalingFamilies.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -91,6 +92,21 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"ring_pantograph_deployed", 0, 0, "ring_pantograph_deployed", "= ring_pantograph 4 60"},
       {"parallelogram_grid", 2, 2, "parallelogram_grid R C",
        "R x C grid of continuous bars; planar DOF 1 G R+C+1-2RC R 2RC-R-C"},
+      {"chain", 1, 1, "chain N [--shape straight|zigzag] [--order root-first|leaf-first]",
+       "open revolute chain of N links; planar DOF N G N R 0, spatial DOF N G N R 0"},
+      {"ring", 1, 1, "ring N (N >= 3)",
+       "one loop of N links on a circle, one grounded; planar DOF N-3 G N-3 R 0, spatial DOF N-3 G N-6 R 3"},
+      {"bar_lattice", 2, 2, "bar_lattice R C",
+       "pin-jointed square bar lattice, R x C cells, bar h_0_0 grounded; planar DOF R+C-1 G R+C-1 R 0 "
+       "(Bolker-Crapo)"},
+      {"braced_lattice", 2, 2, "braced_lattice R C",
+       "bar_lattice with taut cables in both diagonals of every cell; planar DOF 0 G R+C-1-2RC R 2RC-R-C+1"},
+      {"truss_mast", 1, 1, "truss_mast N",
+       "braced triangular truss mast, N bays, struts as distance constraints, for --mode spatial; "
+       "spatial DOF 0 G -3N R 3N (Maxwell s = 3N)"},
+      {"ring_pantograph_net", 1, 2, "ring_pantograph_net N (N >= 3) [OPENING_DEG=150]",
+       "ring_pantograph with a cable net (hoop + diagonal cables, taut at 60 deg); "
+       "planar folded DOF 1 G -3 R 4, deployed DOF 0 G -3-2N R 2N+3"},
   };
   return families;
 }
@@ -129,8 +145,19 @@ GeneratorResult<GenerateRequest> parseGenerateArguments(const std::vector<std::s
           return GeneratorError{"--visuals: expected 0 or 1, got '" + value + "'"};
         }
         request.visuals = value == "1";
+      } else if (key == "shape") {
+        if (value != "straight" && value != "zigzag") {
+          return GeneratorError{"--shape: expected straight or zigzag, got '" + value + "'"};
+        }
+        request.shape = value;
+      } else if (key == "order") {
+        if (value != "root-first" && value != "leaf-first") {
+          return GeneratorError{"--order: expected root-first or leaf-first, got '" + value + "'"};
+        }
+        request.order = value;
       } else {
-        return GeneratorError{"unknown option '" + arg + "' (options: --scale, --name, --visuals)"};
+        return GeneratorError{"unknown option '" + arg +
+                              "' (options: --scale, --name, --visuals; chain: --shape, --order)"};
       }
       continue;
     }
@@ -139,6 +166,9 @@ GeneratorResult<GenerateRequest> parseGenerateArguments(const std::vector<std::s
       return GeneratorError{request.family + ": expected an integer, got '" + arg + "'"};
     }
     request.counts.push_back(*count);
+  }
+  if ((request.shape || request.order) && request.family != "chain") {
+    return GeneratorError{request.family + ": --shape and --order are options of chain only"};
   }
   const int numCounts = static_cast<int>(request.counts.size());
   if (numCounts < info->minCounts || numCounts > info->maxCounts) {
@@ -232,6 +262,26 @@ GeneratorResult<MechanismDescription> generateMechanism(const GenerateRequest& r
     mechanism.name = family;
   } else if (family == "parallelogram_grid") {
     mechanism = makeParallelogramGrid(n.at(0), n.at(1));
+  } else if (family == "chain") {
+    mechanism = makeChain(
+        n.at(0), request.shape.value_or("straight") == "zigzag" ? ChainShape::Zigzag : ChainShape::Straight,
+        request.order.value_or("root-first") == "leaf-first" ? ChainOrder::LeafFirst : ChainOrder::RootFirst);
+  } else if (family == "ring") {
+    if (n.at(0) < 3) {
+      return GeneratorError{"ring: N must be at least 3 (a loop needs three links), got " +
+                            std::to_string(n[0])};
+    }
+    mechanism = makeRing(n[0]);
+  } else if (family == "bar_lattice" || family == "braced_lattice") {
+    mechanism = makeBarLattice(n.at(0), n.at(1), family == "braced_lattice");
+  } else if (family == "truss_mast") {
+    mechanism = makeTrussMast(n.at(0));
+  } else if (family == "ring_pantograph_net") {
+    if (n.at(0) < 3 || (n.size() > 1 && (n[1] < 60 || n[1] > 179))) {
+      return GeneratorError{
+          "ring_pantograph_net: N must be at least 3 and OPENING_DEG in 60..179 (it deploys to 60)"};
+    }
+    mechanism = makeRingPantographNet(n[0], n.size() > 1 ? n[1] : 150.0);
   } else {
     return GeneratorError{"unknown family '" + family + "'"};
   }

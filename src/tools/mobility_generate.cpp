@@ -1,5 +1,5 @@
-/// mobility_generate FAMILY [N ...] [--scale S] [--name NAME] [--visuals 0|1] > model.urdf
-/// Writes a closed-loop URDF (DESIGN.md §2) that closes exactly at the written pose.
+/// mobility_generate FAMILY [N ...] [--scale S] [--name NAME] [--visuals 0|1] [--shape …] [--order …] >
+/// model.urdf Writes a closed-loop URDF (DESIGN.md §2) that closes exactly at the written pose.
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
 #include "mobility_analysis/generators/FamilyRegistry.hpp"
 

@@ -8,6 +8,7 @@
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
+#include "mobility_analysis/generators/ScalingFamilies.hpp"
 
 using namespace mobility_analysis;
 
@@ -38,10 +39,75 @@ std::vector<Family> families() {
                     [n] { return makeParallelogramGrid(n, n + 1); },
                     [n] { return expectParallelogramGrid(n, n + 1); }});
   }
+  // Issue 13's families at N = 3..6, with closed forms written here from the counts (not the generators'
+  // expect* functions): Grübler from links and joints, DOF from the literature's argument for each.
+  auto planar = [](int dof, int grubler) {
+    return FamilyExpectation{"planar", 3, dof, grubler, dof - grubler};
+  };
+  auto spatial = [](int dof, int grubler) {
+    return FamilyExpectation{"spatial", 6, dof, grubler, dof - grubler};
+  };
+  for (int n = 3; n <= 6; ++n) {
+    const std::string tag = std::to_string(n);
+    // Open chain, N + 1 links, N revolutes: 3(N + 1 − N − 1) + N = N in the plane, 6·0 + N in space.
+    list.push_back({"chain_" + tag, [n] { return makeChain(n); },
+                    [=] {
+                      return std::vector<FamilyExpectation>{planar(n, n), spatial(n, n)};
+                    }});
+    list.push_back({"chain_zigzag_leaf_first_" + tag,
+                    [n] { return makeChain(n, ChainShape::Zigzag, ChainOrder::LeafFirst); },
+                    [=] {
+                      return std::vector<FamilyExpectation>{planar(n, n), spatial(n, n)};
+                    }});
+    // Ring: N links, N revolutes, one loop: 3(N − N − 1) + N = N − 3; in space 6(−1) + N = N − 6, but every
+    // axis is parallel, so the loop's 3 out-of-plane equations are dependent and the DOF stays N − 3.
+    list.push_back({"ring_" + tag, [n] { return makeRing(n); },
+                    [=] {
+                      return std::vector<FamilyExpectation>{planar(n - 3, n - 3), spatial(n - 3, n - 6)};
+                    }});
+    // Braced truss mast: N triangles (6 each) held by 9N struts: 6N − 9N; rigid, so 3N self-stresses.
+    list.push_back({"truss_mast_" + tag, [n] { return makeTrussMast(n); },
+                    [=] { return std::vector<FamilyExpectation>{spatial(0, -3 * n)}; }});
+    // Ring pantograph with 2N net cables: the ring's −3 with every cable slack (folded); deployed, every
+    // cable taut (−1 each) and the ring's one motion stopped.
+    list.push_back({"ring_pantograph_net_folded_" + tag, [n] { return makeRingPantographNet(n, 150); },
+                    [=] { return std::vector<FamilyExpectation>{planar(1, -3)}; }});
+    list.push_back({"ring_pantograph_net_deployed_" + tag, [n] { return makeRingPantographNet(n, 60); },
+                    [=] { return std::vector<FamilyExpectation>{planar(0, -3 - 2 * n)}; }});
+  }
+  for (auto [r, c] : {std::pair{3, 3}, std::pair{3, 5}, std::pair{4, 6}, std::pair{6, 4}}) {
+    const std::string tag = std::to_string(r) + "x" + std::to_string(c);
+    // Bar framework: n nodes, b bars, DOF 2n − b − 3 (no self-stress); as links b − 1 moving bars and 2b − n
+    // pins: 3(b − 1) − 2(2b − n) = 2n − b − 3.
+    const int nodes = (r + 1) * (c + 1), bars = r * (c + 1) + c * (r + 1);
+    const int mechanisms = 2 * nodes - bars - 3;
+    EXPECT_EQ(mechanisms, r + c - 1);  // Bolker & Crapo
+    list.push_back({"bar_lattice_" + tag, [r = r, c = c] { return makeBarLattice(r, c); },
+                    [=] { return std::vector<FamilyExpectation>{planar(mechanisms, mechanisms)}; }});
+    // Both diagonals braced by taut cables: rigid, 2rc more distance equations.
+    list.push_back({"braced_lattice_" + tag, [r = r, c = c] { return makeBarLattice(r, c, true); },
+                    [=] { return std::vector<FamilyExpectation>{planar(0, mechanisms - 2 * r * c)}; }});
+  }
   return list;
 }
 
 }  // namespace
+
+TEST(ScalingFamilies, GeneratorsStateTheSameClosedForms) {
+  // What the generated file says it expects (its header comment, the registry's line) is what is tested.
+  for (int n = 3; n <= 6; ++n) {
+    for (const auto& [m, planar, spatialG] :
+         {std::tuple{makeChain(n), n, n}, std::tuple{makeRing(n), n - 3, n - 6}}) {
+      ASSERT_EQ(m.expectations.size(), 2u);
+      EXPECT_EQ(m.expectations[0].grubler, planar);
+      EXPECT_EQ(m.expectations[1].grubler, spatialG);
+    }
+    EXPECT_EQ(makeTrussMast(n).expectations.at(0).redundant, 3 * n);
+    EXPECT_EQ(makeRingPantographNet(n, 60).expectations.at(0).redundant, 2 * n + 3);
+    EXPECT_EQ(makeBarLattice(n, n + 1).expectations.at(0).dof, 2 * n);
+    EXPECT_EQ(makeBarLattice(n, n + 1, true).expectations.at(0).redundant, 2 * n * (n + 1) - 2 * n);
+  }
+}
 
 TEST(ScalingFamilies, ClosedFormsHoldAndEveryMethodAgrees) {
   for (const Family& family : families()) {
@@ -62,6 +128,9 @@ TEST(ScalingFamilies, ClosedFormsHoldAndEveryMethodAgrees) {
       EXPECT_EQ(report.grublerKutzbachDof, expected.grubler);
       EXPECT_EQ(report.numRedundant, expected.redundant);
       EXPECT_EQ(report.numCoordinates - report.numConstraints, report.grublerKutzbachDof);
+      // Calladine–Maxwell: the states of self-stress are the redundant equations, the modes the DOF.
+      EXPECT_EQ(report.selfStress.count, expected.redundant);
+      EXPECT_EQ(report.selfStress.mechanismModes, expected.dof);
 
       // The report (self-stress basis) against the lecture's order as written: contract-order elimination,
       // and dense Gram-Schmidt where it fits.
@@ -84,5 +153,46 @@ TEST(ScalingFamilies, ClosedFormsHoldAndEveryMethodAgrees) {
         EXPECT_EQ(direct.nullityTrace, dense.nullityTrace);
       }
     }
+  }
+}
+
+TEST(ScalingFamilies, ClosedFormsHoldAtAThousandUnits) {
+  // 10^3 links / cells / bays: every family loads and analyses, with the closed forms of the small sizes.
+  struct Case {
+    std::string name;
+    MechanismDescription mechanism;
+    AnalysisMode mode;
+    int dof, grubler;
+  };
+  const int n = 1000;
+  const std::vector<Case> cases = {
+      {"chain", makeChain(n), AnalysisMode::Planar, n, n},
+      {"chain zigzag leaf-first", makeChain(n, ChainShape::Zigzag, ChainOrder::LeafFirst),
+       AnalysisMode::Planar, n, n},
+      {"ring", makeRing(n), AnalysisMode::Planar, n - 3, n - 3},
+      {"ring in space", makeRing(n), AnalysisMode::Spatial, n - 3, n - 6},
+      {"bar lattice 32x32", makeBarLattice(32, 32), AnalysisMode::Planar, 63, 63},
+      {"braced lattice 32x32", makeBarLattice(32, 32, true), AnalysisMode::Planar, 0, 63 - 2 * 32 * 32},
+      {"truss mast", makeTrussMast(n), AnalysisMode::Spatial, 0, -3 * n},
+      {"ring pantograph net folded", makeRingPantographNet(n, 150), AnalysisMode::Planar, 1, -3},
+      {"ring pantograph net deployed (200)", makeRingPantographNet(200, 60), AnalysisMode::Planar, 0,
+       -3 - 400},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const GeneratorResult<std::string> urdf = toClosedLoopUrdf(c.mechanism, UrdfWriterOptions{false, ""});
+    ASSERT_TRUE(std::holds_alternative<std::string>(urdf));
+    const Result<Mechanism> mechanism =
+        loadMechanismFromString(std::get<std::string>(urdf), c.name + ".urdf");
+    ASSERT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+    AnalysisOptions options;
+    options.mode = c.mode;
+    const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+    ASSERT_TRUE(isOk(analysis)) << diagnosticOf(analysis).toString();
+    const MobilityReport& report = valueOf(analysis).report;
+    EXPECT_EQ(report.dof, c.dof);
+    EXPECT_EQ(report.grublerKutzbachDof, c.grubler);
+    EXPECT_EQ(report.numRedundant, c.dof - c.grubler);
+    EXPECT_EQ(report.selfStress.count, c.dof - c.grubler);
   }
 }

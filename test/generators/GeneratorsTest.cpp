@@ -4,6 +4,7 @@
 #include "mobility_analysis/generators/FamilyRegistry.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
 #include "mobility_analysis/generators/ReferenceMechanisms.hpp"
+#include "mobility_analysis/generators/ScalingFamilies.hpp"
 
 #include <gtest/gtest.h>
 #include <tinyxml2.h>
@@ -57,7 +58,33 @@ std::vector<NamedModel> smallModels() {
       {"grid_1x1", [] { return makeParallelogramGrid(1, 1); }},
       {"grid_2x3", [] { return makeParallelogramGrid(2, 3); }},
       {"grid_3x2", [] { return makeParallelogramGrid(3, 2); }},
+      {"chain_3", [] { return makeChain(3); }},
+      {"chain_5_zigzag", [] { return makeChain(5, ChainShape::Zigzag); }},
+      {"chain_4_leaf_first", [] { return makeChain(4, ChainShape::Zigzag, ChainOrder::LeafFirst); }},
+      {"ring_4", [] { return makeRing(4); }},
+      {"ring_7", [] { return makeRing(7); }},
   };
+}
+
+/// Models that do not move (truss), have no spatial expectation (bar lattices) or carry cables: checked for
+/// closure and well-formed XML, their counts in ScalingFamiliesTest.
+std::vector<NamedModel> structureModels() {
+  return {
+      {"bar_lattice_2x3", [] { return makeBarLattice(2, 3); }},
+      {"braced_lattice_3x2", [] { return makeBarLattice(3, 2, true); }},
+      {"truss_mast_1", [] { return makeTrussMast(1); }},
+      {"truss_mast_3", [] { return makeTrussMast(3); }},
+      {"ring_pantograph_net_4", [] { return makeRingPantographNet(4, 150); }},
+      {"ring_pantograph_net_5_deployed", [] { return makeRingPantographNet(5, 60); }},
+  };
+}
+
+std::vector<NamedModel> allModels() {
+  std::vector<NamedModel> models = smallModels();
+  for (NamedModel& model : structureModels()) {
+    models.push_back(std::move(model));
+  }
+  return models;
 }
 
 const FamilyExpectation* findMode(const MechanismDescription& m, const std::string& mode) {
@@ -131,7 +158,7 @@ TEST(RpyConversion, RoundTripIsExactNearGimbalLock) {
 }
 
 TEST(ClosedLoopUrdf, EveryFamilyClosesExactlyAtTheWrittenPose) {
-  for (const NamedModel& model : smallModels()) {
+  for (const NamedModel& model : allModels()) {
     const MechanismDescription m = model.make();
     const auto layout = computeClosedLoopLayout(m);
     ASSERT_TRUE(std::holds_alternative<ClosedLoopLayout>(layout)) << model.label;
@@ -140,7 +167,7 @@ TEST(ClosedLoopUrdf, EveryFamilyClosesExactlyAtTheWrittenPose) {
 }
 
 TEST(ClosedLoopUrdf, EveryFamilyWritesWellFormedXml) {
-  for (const NamedModel& model : smallModels()) {
+  for (const NamedModel& model : allModels()) {
     const MechanismDescription m = model.make();
     const auto text = toClosedLoopUrdf(m);
     ASSERT_TRUE(std::holds_alternative<std::string>(text)) << model.label;
@@ -343,6 +370,46 @@ TEST(FamilyRegistry, EveryFamilyGenerates) {
   }
 }
 
+TEST(ClosedLoopUrdf, LeafFirstChainListsChildrenBeforeParents) {
+  // The tree joints of a leaf-first chain are written from the free end down, links likewise after the
+  // ground.
+  const auto text = toClosedLoopUrdf(makeChain(4, ChainShape::Straight, ChainOrder::LeafFirst));
+  ASSERT_TRUE(std::holds_alternative<std::string>(text));
+  tinyxml2::XMLDocument doc;
+  ASSERT_EQ(doc.Parse(std::get<std::string>(text).c_str()), tinyxml2::XML_SUCCESS);
+  std::vector<std::string> joints, links;
+  for (const tinyxml2::XMLElement* e = doc.FirstChildElement("robot")->FirstChildElement(); e != nullptr;
+       e = e->NextSiblingElement()) {
+    if (std::string(e->Name()) == "joint")
+      joints.push_back(e->Attribute("name"));
+    if (std::string(e->Name()) == "link")
+      links.push_back(e->Attribute("name"));
+  }
+  EXPECT_EQ(joints, (std::vector<std::string>{"joint_4", "joint_3", "joint_2", "joint_1"}));
+  EXPECT_EQ(links, (std::vector<std::string>{"ground", "link_4", "link_3", "link_2", "link_1"}));
+}
+
+TEST(Expectations, ScalingFamiliesCountWhatTheyBuild) {
+  // Links and joints as the closed forms' derivations count them.
+  for (int n : {3, 6}) {
+    EXPECT_EQ(makeChain(n).links.size(), static_cast<size_t>(n + 1));
+    EXPECT_EQ(makeRing(n).connections.size(), static_cast<size_t>(n));
+    EXPECT_EQ(makeTrussMast(n).connections.size(), static_cast<size_t>(9 * n));
+    EXPECT_EQ(makeRingPantographNet(n, 150).cables.size(), static_cast<size_t>(2 * n + 1));
+  }
+  for (auto [r, c] : {std::pair{1, 1}, std::pair{3, 5}}) {
+    const MechanismDescription lattice = makeBarLattice(r, c);
+    const int nodes = (r + 1) * (c + 1), bars = r * (c + 1) + c * (r + 1);
+    EXPECT_EQ(lattice.links.size(), static_cast<size_t>(bars));
+    EXPECT_EQ(lattice.connections.size(), static_cast<size_t>(2 * bars - nodes));
+    EXPECT_EQ(*computeGrublerCount(lattice, 3), r + c - 1);
+    EXPECT_EQ(makeBarLattice(r, c, true).cables.size(), static_cast<size_t>(2 * r * c));
+  }
+  EXPECT_EQ(*computeGrublerCount(makeTrussMast(5), 6), -15);
+  EXPECT_EQ(*computeGrublerCount(makeRing(1000), 3), 997);
+  EXPECT_EQ(*computeGrublerCount(makeChain(1000, ChainShape::Zigzag, ChainOrder::LeafFirst), 3), 1000);
+}
+
 TEST(FamilyRegistry, RejectsBadArguments) {
   const std::vector<std::vector<std::string>> bad = {
       {},
@@ -355,6 +422,10 @@ TEST(FamilyRegistry, RejectsBadArguments) {
       {"four_bar", "--colour", "red"},
       {"four_bar", "--scale"},
       {"parallelogram_grid", "3"},
+      {"chain", "3", "--shape", "curly"},
+      {"chain", "3", "--order", "sideways"},
+      {"ring", "3", "--shape", "zigzag"},
+      {"bar_lattice", "3"},
   };
   for (const auto& args : bad) {
     EXPECT_TRUE(std::holds_alternative<GeneratorError>(parseGenerateArguments(args))) << args.size();
@@ -362,6 +433,22 @@ TEST(FamilyRegistry, RejectsBadArguments) {
   const auto hoberman = parseGenerateArguments({"hoberman", "2"});
   ASSERT_TRUE(std::holds_alternative<GenerateRequest>(hoberman));
   EXPECT_TRUE(std::holds_alternative<GeneratorError>(generateMechanism(std::get<GenerateRequest>(hoberman))));
+}
+
+TEST(FamilyRegistry, ChainOptionsReachTheGenerator) {
+  const auto request = parseGenerateArguments({"chain", "5", "--shape", "zigzag", "--order", "leaf-first"});
+  ASSERT_TRUE(std::holds_alternative<GenerateRequest>(request));
+  const auto mechanism = generateMechanism(std::get<GenerateRequest>(request));
+  ASSERT_TRUE(std::holds_alternative<MechanismDescription>(mechanism));
+  const MechanismDescription& m = std::get<MechanismDescription>(mechanism);
+  EXPECT_TRUE(m.treeJointsLeafFirst);
+  EXPECT_EQ(m.links[1].name, "link_5");
+  EXPECT_NEAR(m.connections.back().frame.translation().y(), 0.0, 1e-15);   // joint_1 at the origin
+  EXPECT_NEAR(m.connections.front().frame.translation().y(), 0.0, 1e-15);  // joint_5 at x = 0.4, y = 0
+  EXPECT_NEAR(m.connections[1].frame.translation().y(), 0.05, 1e-15);      // joint_4 at x = 0.3, off axis
+  const auto ring = parseGenerateArguments({"ring", "2"});
+  ASSERT_TRUE(std::holds_alternative<GenerateRequest>(ring));
+  EXPECT_TRUE(std::holds_alternative<GeneratorError>(generateMechanism(std::get<GenerateRequest>(ring))));
 }
 
 TEST(MobilityGenerateCli, BadArgumentsExitTwo) {

@@ -27,6 +27,8 @@ struct GenerateRequest {
   double scale = 1.0;               ///< `--scale`: multiplies every length (1000: millimetres).
   std::optional<std::string> name;  ///< `--name`: URDF robot name.
   bool visuals = true;              ///< `--visuals 0|1`.
+  std::optional<std::string> shape;  ///< `--shape straight|zigzag` (chain only).
+  std::optional<std::string> order;  ///< `--order root-first|leaf-first` (chain only).
 };
 
 /**

@@ -103,6 +103,7 @@ struct MechanismDescription {
   std::vector<FamilyExpectation> expectations;  ///< One per mode the model is meant to be analysed in.
   std::vector<CableDescription> cables;         ///< Written after the loop joints as `<cable>` elements.
   double visualRadius = 0.01;                   ///< Radius of the drawn cylinders [m].
+  bool treeJointsLeafFirst = false;  ///< Write the tree `<joint>`s children first (a leaf-first file).
 };
 
 /// Why a description or a command line could not be turned into a URDF.
