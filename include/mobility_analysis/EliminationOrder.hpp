@@ -16,6 +16,9 @@ namespace mobility_analysis {
 struct EliminationOrder {
   std::vector<int> rows;            ///< Every equation once, in the order to take them (dim num_constraints).
   std::vector<int> columnPriority;  ///< Position of each coordinate in the sweep (dim num_coordinates).
+  /// Whether each equation is one of a connection that closes a loop (joins a link to an earlier one that it
+  /// does not attach to) rather than one of a link or of the connection attaching it (dim num_constraints).
+  std::vector<char> closing;
 };
 
 /**

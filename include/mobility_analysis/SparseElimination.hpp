@@ -82,6 +82,8 @@ class SparseElimination {
   int numColumns() const { return static_cast<int>(pivotOfColumn_.size()); }
   double smallestKeptPivot() const;  ///< 0 when no row was kept.
   double largestDroppedResidual() const { return largestDropped_; }
+  /// Entries kept so far, of the pivot rows and their multipliers: the fill, which the time follows.
+  size_t storedEntries() const { return entries_.size() + pivotMultipliers_.size(); }
 
  private:
   int priority(int column) const { return columnPriority_.empty() ? column : columnPriority_[column]; }

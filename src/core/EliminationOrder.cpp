@@ -89,6 +89,7 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
   EliminationOrder order;
   order.rows.reserve(model.numConstraints());
   order.columnPriority.assign(model.numCoordinates(), 0);
+  order.closing.assign(model.numConstraints(), 0);
   int nextColumn = 0;
   std::vector<int> closing;
   // Within a link, the elements its rigid-link equations express (p = p0 + a d1 + b d2 + c d1 x d2) come
@@ -127,8 +128,13 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
         return a == attaching;
       return discovered[otherEnd(a, link)] > discovered[otherEnd(b, link)];
     });
-    for (int j : closing)
+    for (int j : closing) {
       order.rows.insert(order.rows.end(), jointRows[j].begin(), jointRows[j].end());
+      if (j != attaching) {
+        for (int r : jointRows[j])
+          order.closing[r] = 1;
+      }
+    }
   }
   return order;
 }

@@ -16,6 +16,13 @@ constexpr size_t kTraceLimit = 160;
 /// as it really is global (a ring's) [equations].
 constexpr size_t kLocalLimit = 6000;
 
+/// Local searches that may fail in a row before the basis stops searching locally (see futileFinds).
+constexpr int kFutileFinds = 8;
+
+/// The sweep from the ground is abandoned once it has stored this many times J's entries, plus kFillFloor.
+constexpr size_t kFillFactor = 8;
+constexpr size_t kFillFloor = 1000000;
+
 /// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
 constexpr double kStressNoise = 1e-10;
 
@@ -189,26 +196,17 @@ class LocalStressFinder {
   int lastRadius_ = 1;
 };
 
-}  // namespace
-
-SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
-                                       const SparseJacobian& J, double tolerance,
-                                       const ProgressCallback& progress) {
-  EliminationOrder order = computeSweepOrder(mechanism, model);
+/**
+ * One elimination of J in @p order, tracing each dependent row's stress (locally where the trace runs long).
+ * @param[in] fillBudget give up (return nothing) once the elimination has stored more entries than this; 0:
+ * no limit.
+ */
+std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const CoordinateModel& model,
+                                          const SparseJacobian& J, const EliminationOrder& order,
+                                          double tolerance, size_t fillBudget,
+                                          const ProgressCallback& progress) {
   const int m = static_cast<int>(J.rows());
   const int n = static_cast<int>(J.cols());
-  // A tree (only tree joints carry equations) has no loop for a stress to close, but swept from the ground every
-  // reduced row is written in the free coordinates of all the links above it: the fill, and the time, grow as
-  // the square of its depth (a 2 10^5-link chain ran out of memory). Swept from the leaves instead, each link's
-  // rows pivot on its own coordinates before its parent's are seen, and nothing fills in.
-  const bool tree = std::all_of(mechanism.joints.begin(), mechanism.joints.end(), [&](const Joint& joint) {
-    return joint.kind == ConnectionKind::TreeJoint;
-  });
-  if (tree) {
-    std::reverse(order.rows.begin(), order.rows.end());
-    for (int& priority : order.columnPriority)
-      priority = n - 1 - priority;
-  }
   std::vector<int> position(m, 0);
   for (size_t i = 0; i < order.rows.size(); ++i)
     position[order.rows[i]] = static_cast<int>(i);
@@ -221,26 +219,37 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
   // A traced stress longer than this is found again locally; it follows the local stresses' size, so a
   // mechanism whose loops are large is not re-solved stress by stress.
   size_t traceLimit = kTraceLimit;
+  // Local searches that failed in a row. A failed search grows its ball to kLocalLimit equations and costs
+  // far more than the full trace it falls back on; where the stresses are really long (a grid of continuous
+  // bars: 1 of 19 800 stresses of the 100 x 100 grid was found locally, after 1 500 failed searches that took
+  // 80% of the whole report's time) the search stops after kFutileFinds failures in a row. One global stress
+  // among local ones (a ring's) fails once and leaves the search on.
+  int futileFinds = 0;
   const size_t progressStep = std::max<size_t>(1, order.rows.size() / 20);
   for (size_t i = 0; i < order.rows.size(); ++i) {
     if (progress && i % progressStep == 0) {
       progress(static_cast<double>(i) / static_cast<double>(m));
     }
+    if (fillBudget > 0 && elimination.storedEntries() > fillBudget)
+      return std::nullopt;
     const int r = order.rows[i];
     const double norm = J.row(r).norm();
     if (!elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent) {
       continue;
     }
     std::optional<SelfStress> stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
-    if (!stress) {
+    if (!stress && futileFinds < kFutileFinds) {
       stress = finder.find(r);
       if (stress) {
         ++basis.locallyResolved;
         traceLimit = std::max(traceLimit, 2 * stress->size());
+        futileFinds = 0;
       } else {
-        stress = elimination.traceDependency(r, elimination.multipliers());
+        ++futileFinds;
       }
     }
+    if (!stress)
+      stress = elimination.traceDependency(r, elimination.multipliers());
     basis.stresses.push_back(std::move(*stress));
   }
   basis.rank = elimination.rank();
@@ -251,6 +260,62 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
     basis.motions = std::move(*motions);
     basis.motionsComputed = true;
   }
+  return basis;
+}
+
+/**
+ * The sweep's spanning tree taken backwards, from its leaves to the ground, then the connections that close
+ * loops in the sweep's order: the rows of each link pivot on its own coordinates before its parent's are seen
+ * (no fill along a chain), and each closing connection is reduced once along its loop.
+ */
+EliminationOrder leavesFirst(const EliminationOrder& order) {
+  EliminationOrder result = order;
+  result.rows.clear();
+  for (auto it = order.rows.rbegin(); it != order.rows.rend(); ++it) {
+    if (order.closing[*it] == 0)
+      result.rows.push_back(*it);
+  }
+  for (int r : order.rows) {
+    if (order.closing[r] != 0)
+      result.rows.push_back(r);
+  }
+  const int n = static_cast<int>(order.columnPriority.size());
+  for (int& priority : result.columnPriority)
+    priority = n - 1 - priority;
+  return result;
+}
+
+}  // namespace
+
+SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
+                                       const SparseJacobian& J, double tolerance,
+                                       const ProgressCallback& progress, size_t fillBudget) {
+  EliminationOrder order = computeSweepOrder(mechanism, model);
+  // A tree (only tree joints carry equations) has no loop for a stress to close, but swept from the ground
+  // every reduced row is written in the free coordinates of all the links above it: the fill, and the time,
+  // grow as the square of its depth (a 2 10^5-link chain ran out of memory). Swept from the leaves instead,
+  // each link's rows pivot on its own coordinates before its parent's are seen, and nothing fills in.
+  const bool tree = std::all_of(mechanism.joints.begin(), mechanism.joints.end(),
+                                [&](const Joint& joint) { return joint.kind == ConnectionKind::TreeJoint; });
+  std::optional<SelfStressBasis> found;
+  if (tree) {
+    found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, 0, progress);
+  } else {
+    // Loops can fill the same way: each arc of a long ring is such a chain, and swept from the ground the
+    // 2.5 10^4 links of a ring stored 3 10^8 entries (10^5 links: out of memory). The sweep from the ground
+    // keeps the stresses of short loops local and is kept while its fill stays within kFillFactor times J's
+    // entries (on every bundled mechanism, the masts and the grids it stays below twice; past it the fill
+    // grows as the square of the depth); past that it is abandoned for the spanning tree from the leaves and
+    // the closing connections after it (a ring: about J's entries), and if that fills as well, the sweep from
+    // the ground is run to the end.
+    const size_t budget = kFillFactor * static_cast<size_t>(J.nonZeros()) + kFillFloor;
+    found = sweepBasis(mechanism, model, J, order, tolerance, fillBudget > 0 ? fillBudget : budget, progress);
+    if (!found)
+      found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, budget, progress);
+    if (!found)
+      found = sweepBasis(mechanism, model, J, order, tolerance, 0, progress);
+  }
+  SelfStressBasis basis = std::move(*found);
 
   // Each stress scaled to unit largest coefficient, rounding noise dropped.
   for (SelfStress& stress : basis.stresses) {

@@ -4,6 +4,8 @@
 #include "mobility_analysis/SelfStressBasis.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -52,10 +54,10 @@ Eigen::VectorXd toDense(const SelfStress& stress, const SparseJacobian& J) {
 }
 
 /// Every check of the basis and the ordered answer on one model.
-void checkModel(const Model& m, const std::string& name, bool dense) {
+void checkModel(const Model& m, const std::string& name, bool dense, size_t fillBudget = 0) {
   SCOPED_TRACE(name);
   const SelfStressBasis basis =
-      computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
+      computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank, {}, fillBudget);
   const OrderedRank direct = computeOrderedRank(m.J, tolerances::kRank, false);
   ASSERT_EQ(basis.rank, direct.rank);
   ASSERT_EQ(static_cast<int>(basis.stresses.size()), m.J.rows() - direct.rank);
@@ -200,4 +202,68 @@ TEST(SelfStressBasis, StressesThatRunDownAChainAreFoundAgainLocally) {
     largest = std::max(largest, stress.size());
   EXPECT_LE(largest, 400u);
   checkModel(m, "sle_triangular 30", false);
+}
+
+namespace {
+
+/// A regular polygon of @p links revolute joints about z (the ground is one side), closed by a loop joint:
+/// planar DOF links - 3, and in space 3 redundant equations (a planar loop).
+std::string ringUrdf(int links) {
+  const double pi = std::acos(-1.0), step = 2.0 * pi / links, radius = 0.05 * links / pi;
+  const double chord = 2.0 * radius * std::sin(step / 2.0);
+  auto number = [](double x) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.17g", x);
+    return std::string(text);
+  };
+  std::string text = "<robot name='ring'><link name='l0'/>";
+  for (int i = 1; i < links; ++i) {
+    const std::string xyz = number(i == 1 ? radius : chord) + " 0 0";
+    const std::string yaw = number(i == 1 ? pi / 2.0 + step / 2.0 : step);
+    text += "<link name='l" + std::to_string(i) + "'/><joint name='j" + std::to_string(i) +
+            "' type='revolute'><parent link='l" + std::to_string(i - 1) + "'/><child link='l" +
+            std::to_string(i) + "'/><origin xyz='" + xyz + "' rpy='0 0 " + yaw +
+            "'/><axis xyz='0 0 1'/></joint>";
+  }
+  return text + "<loop_joint name='close' type='revolute'><link1 link='l" + std::to_string(links - 1) +
+         "' xyz='" + number(chord) + " 0 0'/><link2 link='l0' xyz='" + number(radius) +
+         " 0 0'/><axis xyz='0 0 1'/></loop_joint></robot>";
+}
+
+}  // namespace
+
+TEST(SelfStressBasis, ALongRingIsTakenFromItsLeavesAndKeepsTheOrderedAnswer) {
+  // Swept from the ground, each arc of a ring fills like a chain swept from its root; past the fill budget
+  // the basis takes the spanning tree from the far end and the closing joint last. The answer must not
+  // change: the ordered redundancy equals the contract-order elimination (and the dense method where it
+  // runs), 3 equations in space (a planar loop), none in the plane, links - 3 DOF in both.
+  for (int links : {12, 41, 600}) {
+    Result<Mechanism> mechanism = loadMechanismFromString(ringUrdf(links), "ring.urdf");
+    ASSERT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+    for (AnalysisMode mode : {AnalysisMode::Planar, AnalysisMode::Spatial}) {
+      const Model m = buildModel(valueOf(mechanism), mode);
+      for (size_t budget : {size_t{0}, size_t{1}}) {
+        const std::string name = "ring of " + std::to_string(links) + " " + toString(mode) +
+                                 (budget == 1 ? " leaves first" : " from the ground");
+        checkModel(m, name, links < 50, budget);
+        const SelfStressBasis basis =
+            computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank, {}, budget);
+        EXPECT_EQ(basis.stresses.size(), mode == AnalysisMode::Spatial ? 3u : 0u) << name;
+        EXPECT_EQ(m.J.cols() - basis.rank, links - 3) << name;
+      }
+    }
+  }
+}
+
+TEST(SelfStressBasis, TheLeavesFirstOrderKeepsTheAnswerOnLoopyMechanisms) {
+  // Forced on mechanisms with many loops (where the sweep from the ground is the one kept), the leaves-first
+  // order still yields a basis with the contract-order answer.
+  for (int n : {1, 3}) {
+    checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Planar),
+               "grid leaves first", true, 1);
+    checkModel(buildModel(generated(makeSleSpatialMast(2 * n)), AnalysisMode::Spatial), "mast leaves first",
+               true, 1);
+  }
+  for (const char* file : {"bricard.urdf", "stewart_6sps.urdf", "hoberman_ring.urdf", "door.urdf"})
+    checkModel(buildModel(loadOrFail(urdfPath(file)), AnalysisMode::Spatial), file, true, 1);
 }

@@ -1,6 +1,7 @@
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <set>
@@ -60,62 +61,91 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     connectionsAt[mechanism.joints[j].link1].push_back(static_cast<int>(j));
     connectionsAt[mechanism.joints[j].link2].push_back(static_cast<int>(j));
   }
-  // Candidate groups: every link with two connections but the ground, and chains of such links.
-  std::set<std::vector<int>> groups;
+  // Candidate groups: every link with two connections but the ground, and chains of such links. Each group's
+  // links sorted and padded with -1, so that the groups sort (and are taken) as sorted vectors would.
+  using Group = std::array<int, kMaxGroup>;
+  std::vector<Group> groups;
+  auto addGroup = [&](const std::vector<int>& path) {
+    Group group;
+    group.fill(-1);
+    for (size_t i = 0; i < path.size(); ++i) {  // insertion sort of at most kMaxGroup links
+      size_t k = i;
+      for (; k > 0 && group[k - 1] > path[i]; --k)
+        group[k] = group[k - 1];
+      group[k] = path[i];
+    }
+    groups.push_back(group);
+  };
+  std::vector<int> chain;
+  std::function<void(std::vector<int>&)> extend = [&](std::vector<int>& path) {
+    if (path.size() >= kMaxGroup)
+      return;
+    const int last = path.back();
+    if (connectionsAt[last].size() != 2)
+      return;
+    for (int j : connectionsAt[last]) {
+      const Joint& joint = mechanism.joints[j];
+      const int next = joint.link1 == last ? joint.link2 : joint.link1;
+      if (next == mechanism.rootLink || connectionsAt[next].size() != 2 ||
+          std::find(path.begin(), path.end(), next) != path.end())
+        continue;
+      path.push_back(next);
+      addGroup(path);
+      extend(path);
+      path.pop_back();
+    }
+  };
   for (int l = 0; l < numLinks; ++l) {
-    if (l == mechanism.rootLink || connectionsAt[l].empty())
+    if (l == mechanism.rootLink || connectionsAt[l].size() != 2)
       continue;
-    if (connectionsAt[l].size() == 2)
-      groups.insert({l});
-    std::vector<int> chain = {l};
-    std::function<void(std::vector<int>&)> extend = [&](std::vector<int>& path) {
-      if (path.size() >= kMaxGroup)
-        return;
-      const int last = path.back();
-      if (connectionsAt[last].size() != 2)
-        return;
-      for (int j : connectionsAt[last]) {
-        const Joint& joint = mechanism.joints[j];
-        const int next = joint.link1 == last ? joint.link2 : joint.link1;
-        if (next == mechanism.rootLink || connectionsAt[next].size() != 2 ||
-            std::find(path.begin(), path.end(), next) != path.end())
-          continue;
-        path.push_back(next);
-        std::vector<int> sorted = path;
-        std::sort(sorted.begin(), sorted.end());
-        groups.insert(sorted);
-        extend(path);
-        path.pop_back();
-      }
-    };
-    if (connectionsAt[l].size() == 2)
-      extend(chain);
+    chain.assign(1, l);
+    addGroup(chain);
+    extend(chain);
   }
+  std::sort(groups.begin(), groups.end());
+  groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
 
   const Eigen::SparseMatrix<double> Jc = J;  // column access
   auto element3 = [&](int e) {
     const int o = model.elements[e].offset;
     return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
   };
-  std::vector<Eigen::VectorXd> accepted;  // motions kept, full length
-  std::vector<std::vector<int>> acceptedLinks;
-  for (const std::vector<int>& group : groups) {
-    std::vector<char> inGroup(numLinks, 0);
+  // Motions kept, each as (coordinate, value) over its group's coordinates, and the motions at each link: a
+  // group is compared with those sharing one of its links only, and nothing here costs more than the group's
+  // neighbourhood (a chain of 10^5 links has 3 10^5 candidate groups).
+  std::vector<std::vector<std::pair<int, double>>> accepted;
+  std::vector<std::vector<int>> acceptedAt(numLinks);
+  std::vector<char> inGroup(numLinks, 0);
+  std::vector<int> localColumn(model.numCoordinates(), -1);
+  Eigen::VectorXd moved = q;
+  std::vector<int> group;
+  for (const Group& padded : groups) {
+    group.assign(padded.begin(), std::find(padded.begin(), padded.end(), -1));
     for (int l : group)
       inGroup[l] = 1;
+    struct Reset {  // inGroup back to all zero however this group's iteration ends
+      std::vector<char>& flags;
+      const std::vector<int>& links;
+      ~Reset() {
+        for (int l : links)
+          flags[l] = 0;
+      }
+    } reset{inGroup, group};
     // T: coordinates of the group's elements per twist component (space: omega, v; plane: omega_z, v_x, v_y).
     // Its end connections must reach at least two other links: a link turning on connections to one link
     // only (a door on its hinges, a robot's last link) is that link's output, not an idle motion.
-    std::set<int> outside;
+    std::vector<int> outside;
     for (int l : group) {
       for (int j : connectionsAt[l]) {
         const Joint& joint = mechanism.joints[j];
         if (!inGroup[joint.link1])
-          outside.insert(joint.link1);
+          outside.push_back(joint.link1);
         if (!inGroup[joint.link2])
-          outside.insert(joint.link2);
+          outside.push_back(joint.link2);
       }
     }
+    std::sort(outside.begin(), outside.end());
+    outside.erase(std::unique(outside.begin(), outside.end()), outside.end());
     int ends = 0;
     for (int l : group) {
       for (int j : connectionsAt[l])
@@ -151,14 +181,33 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     }
     std::sort(rows.begin(), rows.end());
     rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-    Eigen::MatrixXd Jsub = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), columns.size());
+    for (size_t c = 0; c < columns.size(); ++c)
+      localColumn[columns[c]] = static_cast<int>(c);
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), lambda);
     for (size_t r = 0; r < rows.size(); ++r) {
       const double norm = J.row(rows[r]).norm();
-      for (size_t c = 0; c < columns.size(); ++c)
-        Jsub(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
-            J.coeff(rows[r], columns[c]) / norm;
+      for (SparseJacobian::InnerIterator it(J, rows[r]); it; ++it) {
+        const int c = localColumn[it.col()];
+        if (c >= 0)
+          A.row(static_cast<Eigen::Index>(r)) += (it.value() / norm) * T.row(c);
+      }
     }
-    const Eigen::MatrixXd A = Jsub * T;
+    for (int c : columns)
+      localColumn[c] = -1;
+    // Most groups (every link of a serial chain) have no null twist at all. sigma_min(A)^2 is at least
+    // 1 / |(A^T A)^-1|_F and sigma_max(A) at most |A|_F: when these bounds clear the nullity test a
+    // hundredfold (far beyond what rounding in A^T A can move them), no twist can pass it and the SVD is
+    // skipped; otherwise it decides exactly as before.
+    if (A.rows() >= lambda) {
+      const Eigen::MatrixXd gram = A.transpose() * A;
+      const Eigen::LLT<Eigen::MatrixXd> llt(gram);
+      if (llt.info() == Eigen::Success) {
+        const double inverseNorm = llt.solve(Eigen::MatrixXd::Identity(lambda, lambda)).norm();
+        if (std::isfinite(inverseNorm) && inverseNorm > 0.0 &&
+            std::sqrt(1.0 / inverseNorm) > 100.0 * kTwistNullity * std::max(A.norm(), 1.0))
+          continue;
+      }
+    }
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
     const Eigen::VectorXd sigma = svd.singularValues();
     const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
@@ -177,7 +226,7 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
       // Finite: the group moved by exp(step xi) keeps every constraint.
       const double scale = kFiniteStep / std::max(omega.norm(), v.norm());
       const Eigen::Isometry3d g = exponential(scale * omega, scale * v);
-      Eigen::VectorXd moved = q;
+      // (moved is q outside the group: one copy for all groups, put back after each.)
       for (int e : elements) {
         const Eigen::Vector3d x = element3(e);
         const Eigen::Vector3d y = model.elements[e].isPoint ? (g * x).eval() : (g.linear() * x).eval();
@@ -192,34 +241,59 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
                             return form.value(after, eq) - form.value(before, eq);
                           })));
       }
+      for (int e : elements)
+        moved.segment(model.elements[e].offset, dim) = q.segment(model.elements[e].offset, dim);
       if (change > kFiniteResidual)
         continue;
-      // Independent of the motions already kept (only those sharing a link can be dependent).
-      Eigen::VectorXd motion = Eigen::VectorXd::Zero(model.numCoordinates());
+      // Independent of the motions already kept (only those sharing a link can be dependent), compared over
+      // the coordinates they move (every other coordinate is zero in all of them).
+      std::vector<std::pair<int, double>> motion;
       const Eigen::VectorXd local = T * xi;
       for (size_t c = 0; c < columns.size(); ++c)
-        motion(columns[c]) = local(static_cast<Eigen::Index>(c));
-      std::vector<Eigen::VectorXd> overlapping;
-      for (size_t a = 0; a < accepted.size(); ++a) {
-        for (int l : acceptedLinks[a]) {
-          if (inGroup[l]) {
-            overlapping.push_back(accepted[a]);
-            break;
-          }
+        motion.emplace_back(columns[c], local(static_cast<Eigen::Index>(c)));
+      std::vector<int> overlapping;
+      for (int l : group) {
+        for (int a : acceptedAt[l]) {
+          if (std::find(overlapping.begin(), overlapping.end(), a) == overlapping.end())
+            overlapping.push_back(a);
         }
       }
+      std::sort(overlapping.begin(), overlapping.end());
       if (!overlapping.empty()) {
-        Eigen::MatrixXd stack(model.numCoordinates(), static_cast<Eigen::Index>(overlapping.size()) + 1);
+        std::vector<int> support;
+        auto columnOf = [&](int coordinate) {
+          if (localColumn[coordinate] < 0) {
+            localColumn[coordinate] = static_cast<int>(support.size());
+            support.push_back(coordinate);
+          }
+          return localColumn[coordinate];
+        };
+        for (int a : overlapping) {
+          for (const auto& entry : accepted[a])
+            columnOf(entry.first);
+        }
+        for (const auto& entry : motion)
+          columnOf(entry.first);
+        Eigen::MatrixXd stack = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(support.size()),
+                                                      static_cast<Eigen::Index>(overlapping.size()) + 1);
+        auto fill = [&](const std::vector<std::pair<int, double>>& vector, Eigen::Index column) {
+          for (const auto& [coordinate, value] : vector)
+            stack(localColumn[coordinate], column) = value;
+          stack.col(column).normalize();
+        };
         for (size_t a = 0; a < overlapping.size(); ++a)
-          stack.col(static_cast<Eigen::Index>(a)) = overlapping[a].normalized();
-        stack.col(stack.cols() - 1) = motion.normalized();
+          fill(accepted[overlapping[a]], static_cast<Eigen::Index>(a));
+        fill(motion, stack.cols() - 1);
+        for (int coordinate : support)
+          localColumn[coordinate] = -1;
         Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(stack);
         qr.setThreshold(1e-6);
         if (qr.rank() < stack.cols())
           continue;
       }
-      accepted.push_back(motion);
-      acceptedLinks.push_back(group);
+      for (int l : group)
+        acceptedAt[l].push_back(static_cast<int>(accepted.size()));
+      accepted.push_back(std::move(motion));
       // The phrase: the group, what it does, and the connections it turns or slides between.
       PassiveMotion passive;
       std::string names;
