@@ -10,7 +10,9 @@
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "mobility_analysis/Kinematics.hpp"
 #include "mobility_analysis/io/ReadMechanism.hpp"
+#include "mobility_analysis/motion/Deployment.hpp"
 #include "mobility_analysis/ros/DriveableJoints.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
 
@@ -32,6 +34,15 @@ constexpr int kAnimateTurnSteps = 180;
 struct AnalysisTimeout : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// Thrown from a deployment's step callback when a new model was loaded meanwhile; caught in this file only.
+struct DeploymentInterrupted : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// ~deploy: steps when the request says 0, and the most it accepts.
+constexpr int kDefaultDeploySteps = 100;
+constexpr int kMaxDeploySteps = 100000;
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -98,6 +109,7 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
       privateNodeHandle_.advertiseService("get_redundancy", &MobilityServer::getRedundancy, this);
   loadRobotServer_ = privateNodeHandle_.advertiseService("load_robot", &MobilityServer::loadRobot, this);
   moveServer_ = privateNodeHandle_.advertiseService("move", &MobilityServer::move, this);
+  deployServer_ = privateNodeHandle_.advertiseService("deploy", &MobilityServer::deploy, this);
 
   // The joint-state loop has a queue and a thread of its own: a long analysis there never delays a service.
   ros::SubscribeOptions options = ros::SubscribeOptions::create<sensor_msgs::JointState>(
@@ -111,8 +123,15 @@ MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& pri
     motionHandle.setCallbackQueue(&motionQueue_);
     republishTimer_ = motionHandle.createWallTimer(
         ros::WallDuration(1.0 / publishRate_), [this](const ros::WallTimerEvent&) {
-          if (const StatePtr state = current())
+          if (const StatePtr state = current()) {
             jointStatePublisher_.publish(toJointState(state->analysis.report, ros::Time::now()));
+            // ~forces_state changed: redraw (skipped while a state change holds the lock; next tick then).
+            std::unique_lock<std::mutex> motion(motionMutex_, std::try_to_lock);
+            if (motion.owns_lock() && forcesChoice() != publishedForces_) {
+              if (const StatePtr latest = current())
+                publish(*latest, ros::Time::now(), false);
+            }
+          }
         });
   }
   motionSpinner_ = std::make_unique<ros::AsyncSpinner>(1, &motionQueue_);
@@ -463,6 +482,126 @@ bool MobilityServer::move(Move::Request& request, Move::Response& response) {
   });
 }
 
+bool MobilityServer::deploy(Deploy::Request& request, Deploy::Response& response) {
+  return guarded("deploy", response, [&] {
+    response.success = false;
+    std::unique_lock<std::mutex> deploying(deployMutex_, std::try_to_lock);
+    if (!deploying.owns_lock()) {
+      response.message = "deploy: another deployment is running; refused";
+      return;
+    }
+    const StatePtr start = current();
+    if (!start) {
+      response.message = "deploy: no model loaded";
+      return;
+    }
+    const int steps = request.steps == 0 ? kDefaultDeploySteps : request.steps;
+    if (steps < 1 || steps > kMaxDeploySteps || !std::isfinite(request.target_length) ||
+        request.target_length < 0.0 || !(request.duration >= 0.0 && request.duration <= 3600.0)) {
+      response.message = "deploy: steps must be in [1, " + std::to_string(kMaxDeploySteps) +
+                         "] (0: " + std::to_string(kDefaultDeploySteps) +
+                         "), target_length finite and >= 0, duration in [0, 3600] s";
+      return;
+    }
+    const Mechanism& mechanism = *start->mechanism;
+    DeploymentOptions options;
+    options.cable = request.cable;
+    options.steps = steps;
+    options.targetLength = request.target_length;
+    // The final analysis may take ~load_timeout beyond the paced steps.
+    options.analysis = makeOptions(start->mode, {}, loadTimeout_ + request.duration);
+    options.analysis.startPoses = start->analysis.assembled.poses;  // From the state in force.
+    options.analysis.lockActiveCables = request.lock_active_cables;
+    // Each step is shown through the one publishing path (commit): a display state that carries the start's
+    // analysis with this step's poses, positions and cables; the final state replaces it with a full
+    // analysis.
+    const ros::WallDuration pause(request.duration / steps);
+    int published = 0;
+    JointPositions previous = start->analysis.assembled.positions;
+    options.onStep = [&](const DeploymentStep& step, const LinkPoses& poses) {
+      if (published > 0 && request.duration > 0.0)
+        pause.sleep();
+      lastInputTime_ = ros::WallTime::now().toSec();  // A deployment is input: ~animate waits for it.
+      std::lock_guard<std::mutex> motion(motionMutex_);
+      const StatePtr from = current();
+      if (!from || from->generation != start->generation)
+        throw DeploymentInterrupted("a new model was loaded during the deployment; stopped");
+      auto state = std::make_shared<State>(*start);
+      MobilityAnalysis& analysis = state->analysis;
+      analysis.assembled.poses = poses;
+      analysis.assembled.q = computeCoordinates(analysis.assembled.model, poses);
+      previous = computeJointPositions(mechanism, poses, previous);
+      analysis.assembled.positions = previous;
+      MobilityReport& report = analysis.report;
+      report.positions.clear();
+      for (const Joint& joint : mechanism.joints) {
+        const auto value = previous.find(joint.name);
+        if (joint.kind == ConnectionKind::TreeJoint && value != previous.end())
+          report.positions.push_back(JointValue{joint.name, value->second});
+      }
+      report.cables = step.cables;
+      char line[200];
+      std::snprintf(line, sizeof(line),
+                    "deploying: %s at %.9g m (step %d); the rest of this report is the start's until the "
+                    "deployment ends",
+                    request.cable.c_str(), step.activeLength, published);
+      report.warnings.push_back(line);
+      commit(state, ros::Time::now());
+      ++published;
+    };
+    Result<MobilityAnalysis> result = [&]() -> Result<MobilityAnalysis> {
+      try {
+        return deployMechanism(mechanism, options);
+      } catch (const AnalysisTimeout& e) {
+        return makeDiagnostic("", "deploy", request.cable, e.what());
+      } catch (const DeploymentInterrupted& e) {
+        return makeDiagnostic("", "deploy", request.cable, e.what());
+      }
+    }();
+    if (!isOk(result)) {
+      toFailure(diagnosticOf(result), response);
+      response.steps = published;
+      if (published > 0) {
+        // The steps shown carried the start's report: the start, fully analysed, is served again.
+        std::lock_guard<std::mutex> motion(motionMutex_);
+        if (commit(start, ros::Time::now()))
+          response.message += " (the start state is served again)";
+      }
+      ROS_WARN("deploy: %s (%d states were shown)", response.message.c_str(), published);
+      return;
+    }
+    MobilityAnalysis analysis = valueOf(std::move(result));
+    const DeploymentInfo& info = *analysis.report.deployment;
+    // Served from now on: the mechanism with the active cable at the length it was shortened to (as the
+    // core's final report has it), its full analysis at the deployed pose.
+    auto deployed = std::make_shared<Mechanism>(mechanism);
+    if (const std::optional<int> cable = deployed->findJoint(info.cable))
+      deployed->joints[*cable].length = info.finalLength;
+    auto state = std::make_shared<State>(
+        State{deployed, start->description, start->mode, std::move(analysis), start->generation});
+    {
+      std::lock_guard<std::mutex> motion(motionMutex_);
+      if (!commit(state, ros::Time::now())) {
+        response.message = "deploy: a new model was loaded during the deployment; its result was dropped";
+        return;
+      }
+    }
+    toResponse(state->analysis.report, response);
+    const DeploymentInfo& d = *state->analysis.report.deployment;
+    ROS_INFO("deploy: %s from %.6g m to %.6g m in %zu states, %s; DOF %d, %d states of self-stress%s",
+             d.cable.c_str(), d.initialLength, d.finalLength, d.steps.size(), d.reason.c_str(), d.finalDof,
+             state->analysis.report.selfStress.count,
+             state->analysis.report.selfStress.prestressable ? ", prestressable" : "");
+  });
+}
+
+int MobilityServer::forcesChoice() const {
+  int choice = kForcesAuto;
+  if (!privateNodeHandle_.getParamCached("forces_state", choice) || choice < kForcesAuto)
+    return kForcesAuto;
+  return choice;
+}
+
 void MobilityServer::onJointStates(const sensor_msgs::JointStateConstPtr& message) {
   try {
     lastInputTime_ = ros::WallTime::now().toSec();
@@ -562,7 +701,9 @@ void MobilityServer::publish(const State& state, const ros::Time& stamp, bool ne
     descriptionPublisher_.publish(description);
   }
   jointStatePublisher_.publish(toJointState(state.analysis.report, stamp));
-  markerPublisher_.publish(toMarkerArray(mechanism, poses, state.analysis.report));
+  const int forces = forcesChoice();
+  markerPublisher_.publish(toMarkerArray(mechanism, poses, state.analysis.report, ros::Time(0), forces));
+  publishedForces_ = forces;
   // One latched message with every frame of this state (tf2 listeners keep the latest per child frame).
   tf2_msgs::TFMessage tf;
   tf.transforms = toTransforms(mechanism, poses, fixedFrame_, stamp,

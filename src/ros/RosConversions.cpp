@@ -7,6 +7,7 @@
 #include <map>
 
 #include "mobility_analysis/ElementClassification.h"
+#include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/UrdfLoader.hpp"
 
 namespace mobility_analysis {
@@ -28,6 +29,15 @@ constexpr int kMaxLabelShifts = 4;
 constexpr size_t kMaxLabelsPerCell = 16;
 /// Two joint points closer than this fraction of the characteristic length are one point [-].
 constexpr double kSamePoint = 1e-6;
+/// A slack cable is drawn as dashes about this long, with gaps as long [-].
+constexpr double kDashLength = 0.03;
+/// Most dashes a slack cable is drawn with (a long cable gets longer dashes).
+constexpr int kMaxDashes = 100;
+/// Width of a cable's line [link widths] (a distance constraint keeps 0.5).
+constexpr double kCableWidth = 0.6;
+/// Width of an element in ns `forces`: (kForceWidth + kForceWidthGain sqrt|force|) link widths.
+constexpr double kForceWidth = 1.0;
+constexpr double kForceWidthGain = 2.0;
 
 std_msgs::ColorRGBA makeColor(float r, float g, float b) {
   std_msgs::ColorRGBA color;
@@ -285,7 +295,189 @@ Result<JointPositions> positionsOf(const Request& request, const Mechanism& mech
   return makeJointPositions(request.joint_names, request.positions, mechanism);
 }
 
+/// Bounds of every link point, and the direction "up" the screen (y for a model that lies flat in xy, as
+/// mobility_viewer then looks down on it; else z).
+struct ModelBounds {
+  Eigen::Vector3d lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d upper = Eigen::Vector3d::Constant(-std::numeric_limits<double>::max());
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+};
+
+ModelBounds boundsOf(const std::vector<std::vector<Eigen::Vector3d>>& points) {
+  ModelBounds bounds;
+  for (const auto& link : points) {
+    for (const Eigen::Vector3d& p : link) {
+      bounds.lower = bounds.lower.cwiseMin(p);
+      bounds.upper = bounds.upper.cwiseMax(p);
+    }
+  }
+  if ((bounds.upper.array() < bounds.lower.array()).any()) {
+    bounds.lower = bounds.upper = Eigen::Vector3d::Zero();
+  }
+  const Eigen::Vector3d extent = bounds.upper - bounds.lower;
+  if (extent.z() < 0.2 * std::max(extent.x(), extent.y()))
+    bounds.up = Eigen::Vector3d::UnitY();
+  return bounds;
+}
+
+/// Dashes from @p a to @p b for a LINE_LIST: about kDashLength * scale long with equal gaps, at most
+/// kMaxDashes, at least two; the first starts at @p a and the last ends at @p b.
+std::vector<geometry_msgs::Point> dashes(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double scale) {
+  const double length = (b - a).norm();
+  const int count =
+      std::clamp(static_cast<int>(std::lround(length / (2.0 * kDashLength * scale))), 2, kMaxDashes);
+  // count dashes and count - 1 gaps of equal length.
+  const double piece = 1.0 / (2 * count - 1);
+  std::vector<geometry_msgs::Point> points;
+  points.reserve(2 * count);
+  for (int i = 0; i < count; ++i) {
+    points.push_back(toPoint(a + (2 * i * piece) * (b - a)));
+    points.push_back(toPoint(a + (std::min(1.0, (2 * i + 1) * piece)) * (b - a)));
+  }
+  return points;
+}
+
+std_msgs::ColorRGBA mix(const std::array<float, 3>& from, const std::array<float, 3>& to, double t) {
+  const float u = static_cast<float>(std::clamp(t, 0.0, 1.0));
+  return makeColor(from[0] + u * (to[0] - from[0]), from[1] + u * (to[1] - from[1]),
+                   from[2] + u * (to[2] - from[2]));
+}
+
 }  // namespace
+
+std_msgs::ColorRGBA toCableColor(const std::string& state, ElementClass elementClass, bool& dashed) {
+  dashed = state == "slack";
+  if (dashed)
+    return makeColor(0.55f, 0.55f, 0.55f);
+  if (state == "driving")
+    return makeColor(0.85f, 0.2f, 0.85f);
+  return toColor(elementClass, false);
+}
+
+std_msgs::ColorRGBA toForceColor(double force, bool isSigned) {
+  const double f = std::isfinite(force) ? std::clamp(force, -1.0, 1.0) : 0.0;
+  const double t = std::sqrt(std::abs(f));  // Small forces (a tenth of the largest) still read as their sign.
+  if (!isSigned)
+    return mix({0.6f, 0.8f, 0.6f}, {0.1f, 0.8f, 0.2f}, t);
+  if (f >= 0.0)
+    return mix({0.6f, 0.65f, 0.8f}, {0.1f, 0.35f, 1.0f}, t);
+  return mix({0.8f, 0.6f, 0.6f}, {1.0f, 0.1f, 0.05f}, t);
+}
+
+ForcesSelection selectForces(const SelfStressInfo& info, int choice) {
+  ForcesSelection selection;
+  if (choice == kForcesAuto)
+    choice = info.prestressable && !info.prestress.empty() ? kForcesPrestress : 0;
+  if (choice == kForcesPrestress) {
+    if (info.prestressable && !info.prestress.empty()) {
+      selection.title = "prestress";
+      selection.forces = info.prestress;
+    } else {
+      selection.title = "no prestress (not prestressable)";
+    }
+    return selection;
+  }
+  const int listed = static_cast<int>(info.states.size());
+  if (choice >= 0 && choice < listed) {
+    selection.title = "state of self-stress " + std::to_string(choice) + " of " + std::to_string(info.count);
+    selection.forces = info.states[choice].elements;
+  } else if (info.count == 0) {
+    selection.title = "no state of self-stress";
+  } else {
+    selection.title = "no state " + std::to_string(choice) + " (" + std::to_string(info.count) + " states, " +
+                      std::to_string(listed) + " listed)";
+  }
+  return selection;
+}
+
+std::vector<visualization_msgs::Marker> toForceMarkers(const Mechanism& mechanism, const LinkPoses& poses,
+                                                       const MobilityReport& report, int choice,
+                                                       const ros::Time& stamp) {
+  using visualization_msgs::Marker;
+  std::vector<Marker> markers;
+  if (mechanism.links.empty())
+    return markers;
+  const double scale = report.characteristicLength > 0.0 && std::isfinite(report.characteristicLength)
+                           ? report.characteristicLength
+                           : 1.0;
+  const std::string& frame = mechanism.links[mechanism.rootLink].name;
+  const int numLinks = static_cast<int>(mechanism.links.size());
+  const int numJoints = static_cast<int>(mechanism.joints.size());
+  const ForcesSelection selection = selectForces(report.selfStress, choice);
+  const std::vector<std::vector<Eigen::Vector3d>> points = linkPoints(mechanism, poses, scale);
+
+  const ModelBounds bounds = boundsOf(points);
+  Marker legend =
+      makeMarker(frame, stamp, kForcesNamespace, 0, Marker::TEXT_VIEW_FACING, makeColor(1.0f, 1.0f, 1.0f));
+  Eigen::Vector3d at = 0.5 * (bounds.lower + bounds.upper);
+  // Below the model and the labels that part downwards beneath it.
+  at += (bounds.lower.dot(bounds.up) - at.dot(bounds.up) - 7.0 * kTitleHeight * scale) * bounds.up;
+  legend.pose.position = toPoint(at);
+  legend.scale.x = legend.scale.y = legend.scale.z = 0.8 * kTitleHeight * scale;
+  legend.text = "forces: " + selection.title;
+  if (!selection.forces.empty())
+    legend.text += " (blue tension, red compression, green |force| of links and joints)";
+  markers.push_back(legend);
+
+  for (const ElementForce& f : selection.forces) {
+    const bool isSigned = f.kind == "cable" || f.kind == "distance_constraint";
+    const std_msgs::ColorRGBA color = toForceColor(f.force, isSigned);
+    const double width =
+        (kForceWidth + kForceWidthGain * std::sqrt(std::min(1.0, std::abs(f.force)))) * kLinkWidth * scale;
+    if (f.kind == "link" || f.kind == "boundary") {
+      const std::optional<int> l = mechanism.findLink(f.name);
+      if (!l)
+        continue;
+      const int id = 1 + (f.kind == "link" ? *l : numLinks + numJoints + *l);
+      const std::vector<Eigen::Vector3d>& p = points[*l];
+      Marker m = makeMarker(frame, stamp, kForcesNamespace, id, Marker::LINE_LIST, color);
+      if (p.size() < 2) {
+        m.type = Marker::SPHERE;
+        m.pose.position = toPoint(p.front());
+        m.scale.x = m.scale.y = m.scale.z = 0.8 * kSphereDiameter * scale;
+      } else {
+        m.scale.x = m.scale.y = m.scale.z = width;
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3d& q : p)
+          centroid += q;
+        centroid /= static_cast<double>(p.size());
+        for (size_t a = 0; a < p.size(); ++a) {
+          if (p.size() > kMaxPlateCorners) {
+            m.points.push_back(toPoint(centroid));
+            m.points.push_back(toPoint(p[a]));
+            continue;
+          }
+          for (size_t b = a + 1; b < p.size(); ++b) {
+            m.points.push_back(toPoint(p[a]));
+            m.points.push_back(toPoint(p[b]));
+          }
+        }
+      }
+      markers.push_back(m);
+      continue;
+    }
+    const std::optional<int> j = mechanism.findJoint(f.name);
+    if (!j)
+      continue;
+    const auto [p1, p2] = jointPoints(mechanism, poses, *j);
+    Marker m = makeMarker(frame, stamp, kForcesNamespace, 1 + numLinks + *j, Marker::SPHERE, color);
+    if (isSigned && (p1 - p2).norm() > kSamePoint * scale) {
+      m.type = Marker::LINE_LIST;
+      m.scale.x = m.scale.y = m.scale.z = width;
+      // A model lying flat is seen from above: its cables a little above the plane, so one that runs along a
+      // bar (a base cable along the ground) is not hidden under the bar's colour.
+      const Eigen::Vector3d lift =
+          bounds.up.z() == 0.0 ? Eigen::Vector3d(0.0, 0.0, 2.0 * kLinkWidth * scale) : Eigen::Vector3d::Zero();
+      m.points = {toPoint(p1 + lift), toPoint(p2 + lift)};
+    } else {
+      m.pose.position = toPoint(p2);
+      m.scale.x = m.scale.y = m.scale.z =
+          (1.1 + 0.5 * std::min(1.0, std::abs(f.force))) * kSphereDiameter * scale;
+    }
+    markers.push_back(m);
+  }
+  return markers;
+}
 
 std_msgs::ColorRGBA toColor(ElementClass elementClass, bool isLink) {
   switch (elementClass) {
@@ -423,6 +615,61 @@ void toResponse(const MobilityReport& report, LoadRobot::Response& response) {
   toReportFields(report, response);
 }
 
+void toResponse(const MobilityReport& report, Deploy::Response& response) {
+  response.success = true;
+  response.message.clear();
+  response.stopped_by.clear();
+  response.active_lengths.clear();
+  response.step_dof.clear();
+  response.steps = 0;
+  if (report.deployment) {
+    const DeploymentInfo& d = *report.deployment;
+    response.cable = d.cable;
+    response.initial_length = d.initialLength;
+    response.target_length = d.targetLength;
+    response.final_length = d.finalLength;
+    response.final_dof = d.finalDof;
+    response.stopped_by = d.stoppedBy;
+    response.reason = d.reason;
+    response.steps = static_cast<int>(d.steps.size());
+    response.active_lengths.reserve(d.steps.size());
+    response.step_dof.reserve(d.steps.size());
+    for (const DeploymentStep& step : d.steps) {
+      response.active_lengths.push_back(step.activeLength);
+      response.step_dof.push_back(step.dof);
+    }
+  }
+  response.cables.clear();
+  for (const CableState& c : report.cables) {
+    CableStatus m;
+    m.name = c.name;
+    m.type = c.type;
+    m.state = c.state;
+    m.length = c.length;
+    m.distance = c.distance;
+    response.cables.push_back(m);
+  }
+  toSelfStressMessage(report.selfStress, response.self_stress);
+}
+
+DeploymentInfo fromResponse(const Deploy::Response& response) {
+  DeploymentInfo d;
+  d.cable = response.cable;
+  d.initialLength = response.initial_length;
+  d.targetLength = response.target_length;
+  d.finalLength = response.final_length;
+  d.finalDof = response.final_dof;
+  d.stoppedBy = response.stopped_by;
+  d.reason = response.reason;
+  for (size_t i = 0; i < response.active_lengths.size(); ++i) {
+    DeploymentStep step;
+    step.activeLength = response.active_lengths[i];
+    step.dof = i < response.step_dof.size() ? response.step_dof[i] : 0;
+    d.steps.push_back(step);
+  }
+  return d;
+}
+
 MobilityReport fromResponse(const GetDof::Response& response) {
   MobilityReport report;
   fromDofFields(response, report);
@@ -446,7 +693,8 @@ Result<JointPositions> fromRequest(const GetRedundancy::Request& request, const 
 }
 
 visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const LinkPoses& poses,
-                                              const MobilityReport& report, const ros::Time& stamp) {
+                                              const MobilityReport& report, const ros::Time& stamp,
+                                              int forcesChoice) {
   using visualization_msgs::Marker;
   const double scale = report.characteristicLength > 0.0 && std::isfinite(report.characteristicLength)
                            ? report.characteristicLength
@@ -476,6 +724,9 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
   };
 
   const std::vector<std::vector<Eigen::Vector3d>> allPoints = linkPoints(mechanism, poses, scale);
+  std::map<std::string, const CableState*> cableStates;
+  for (const CableState& c : report.cables)
+    cableStates[c.name] = &c;
   // Labels are pushed away from the model's centre (and joint labels off the joint's axis), so that they
   // stand beside the geometry rather than inside it, and neighbouring labels part.
   Eigen::Vector3d modelCentre = Eigen::Vector3d::Zero();
@@ -554,6 +805,21 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
       m.pose.position = geometry_msgs::Point();
       m.scale.x = m.scale.y = m.scale.z = 0.5 * kLinkWidth * scale;
       m.points = {toPoint(p1), toPoint(p2)};
+      if (joint.kind == ConnectionKind::Cable) {
+        // As the report says; a cable it does not list is taut when its ends are its length apart.
+        const auto listed = cableStates.find(joint.name);
+        std::string state = listed != cableStates.end() ? listed->second->state : std::string();
+        if (state.empty()) {
+          state = joint.cableType == CableType::Active                                       ? "driving"
+                  : joint.length - (p1 - p2).norm() <= tolerances::kCableTaut * joint.length ? "taut"
+                                                                                             : "slack";
+        }
+        bool dashed = false;
+        m.color = toCableColor(state, classOf(report.joints, j), dashed);
+        m.scale.x = m.scale.y = m.scale.z = kCableWidth * kLinkWidth * scale;
+        if (dashed)
+          m.points = dashes(p1, p2, scale);
+      }
     } else if (!isRod) {
       switch (joint.type) {
         case JointType::Revolute:
@@ -673,6 +939,8 @@ visualization_msgs::MarkerArray toMarkerArray(const Mechanism& mechanism, const 
     title.text = text;
     array.markers.push_back(title);
   }
+  const std::vector<Marker> forces = toForceMarkers(mechanism, poses, report, forcesChoice, stamp);
+  array.markers.insert(array.markers.end(), forces.begin(), forces.end());
   return array;
 }
 

@@ -147,7 +147,33 @@ INSTANTIATE_TEST_SUITE_P(
         // Couplings: tree minus one.
         DialectCase{"gripper_mimic.urdf", "", AnalysisMode::Spatial, "spatial", 1, 1, 0, ""},
         DialectCase{"gripper_revolute_mimic.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, ""},
-        DialectCase{"gears_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, ""}),
+        DialectCase{"gears_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, ""},
+        // URDF+ planar leg linkage (hip + a parallelogram knee carrying the foot): 3*4 - 2*5 = 2; in space
+        // 6*4 - 5*5 = -1, the one planar loop's 3 equations redundant.
+        DialectCase{"planar_leg_linkage_urdfplus.urdf", "", AnalysisMode::Auto, "planar", 2, 2, 0,
+                    "planar_leg_linkage_loop_joint.urdf"},
+        DialectCase{"planar_leg_linkage_urdfplus.urdf", "", AnalysisMode::Spatial, "spatial", 2, -1, 3,
+                    "planar_leg_linkage_loop_joint.urdf"},
+        // Gepetto Delta, balls as three revolutes, five 3d closures: 24 - 15 = 9 (3 translations + 6 spins).
+        DialectCase{"delta_gepetto.urdf", "delta_3d.yaml", AnalysisMode::Auto, "spatial", 9, 9, 0,
+                    "delta_loop_joint.urdf"},
+        // Gepetto Cassie-like leg, rods cut in halves welded by two 6d closures: 19 - 12 = 7 (5 motors + 2
+        // spins).
+        DialectCase{"cassie_leg_gepetto.urdf", "cassie_leg_6d.yaml", AnalysisMode::Auto, "spatial", 7, 7, 0,
+                    "cassie_leg_loop_joint.urdf"},
+        // MJCF leg with agility_cassie's topology: Gruebler 7, the plantar four-bar closed by a ball makes
+        // one equation redundant: DOF 8.
+        DialectCase{"cassie_leg_mjcf.xml", "", AnalysisMode::Auto, "spatial", 8, 7, 1,
+                    "cassie_leg_mjcf_loop_joint.urdf"},
+        // SDFormat: loops as a cyclic joint graph. Four-bar 3*3 - 2*4 = 1 (space: 6*3 - 5*4 = -2, 3
+        // redundant); five-bar 3*4 - 2*5 = 2 (space: 6*4 - 5*5 = -1, 3 redundant).
+        DialectCase{"four_bar.sdf", "", AnalysisMode::Auto, "planar", 1, 1, 0, "four_bar_loop_joint.urdf"},
+        DialectCase{"four_bar.sdf", "", AnalysisMode::Spatial, "spatial", 1, -2, 3,
+                    "four_bar_loop_joint.urdf"},
+        DialectCase{"five_bar.sdf", "", AnalysisMode::Auto, "planar", 2, 2, 0,
+                    "five_bar_sdf_loop_joint.urdf"},
+        DialectCase{"five_bar.sdf", "", AnalysisMode::Spatial, "spatial", 2, -1, 3,
+                    "five_bar_sdf_loop_joint.urdf"}),
     [](const ::testing::TestParamInfo<DialectCase>& info) {
       std::string name = std::string(info.param.file) + "_" + info.param.closures + "_" +
                          (info.param.mode == AnalysisMode::Spatial ? "spatial" : "auto");
@@ -166,6 +192,35 @@ TEST(Readers, WithoutItsLoopsEachModelIsTheOpenTreeItWouldBeAnalysedAsToday) {
   std::string gripper = readText(formatPath("gripper_mimic.urdf"));
   gripper = std::regex_replace(gripper, std::regex("<mimic[^>]*/>"), "");
   EXPECT_EQ(reportOf(valueOf(readMechanismFromString(gripper, "g.urdf")), AnalysisMode::Spatial).dof, 2);
+  // The Gepetto trees without their closure files: the Delta's 3 motors + 7 balls * 3, the Cassie-like
+  // leg's 7 revolutes + 4 balls * 3 (the issue's "19 instead of 7").
+  EXPECT_EQ(reportOf(readOrFail(formatPath("delta_gepetto.urdf")), AnalysisMode::Auto).dof, 24);
+  EXPECT_EQ(reportOf(readOrFail(formatPath("cassie_leg_gepetto.urdf")), AnalysisMode::Auto).dof, 19);
+}
+
+TEST(Readers, GepettoDeltaHasTheDofOfTheReferenceDelta) {
+  // The same Delta (geometry of urdf/delta_robot.urdf, DESIGN.md 5) written with ball-jointed rods and
+  // floating platform there, with three-revolute balls and 3d closures here: the same DOF and Gruebler.
+  ReadOptions options;
+  options.closuresFile = formatPath("delta_3d.yaml");
+  const MobilityReport gepetto =
+      reportOf(readOrFail(formatPath("delta_gepetto.urdf"), options), AnalysisMode::Auto);
+  const MobilityReport reference = reportOf(readOrFail(urdfPath("delta_robot.urdf")), AnalysisMode::Auto);
+  EXPECT_EQ(reference.dof, 9);
+  EXPECT_EQ(gepetto.dof, reference.dof);
+  EXPECT_EQ(gepetto.grublerKutzbachDof, reference.grublerKutzbachDof);
+  EXPECT_EQ(gepetto.numRedundant, reference.numRedundant);
+}
+
+TEST(Readers, MjcfCassieLegNamesItsRedundantConnectAndItsSpinningRod) {
+  // The plantar four-bar is planar: its ball closure's out-of-plane equation is the redundant one; the
+  // Achilles rod, between a ball joint and a connect, spins about its own line.
+  const MobilityReport r = reportOf(readOrFail(formatPath("cassie_leg_mjcf.xml")), AnalysisMode::Auto);
+  ASSERT_EQ(r.redundantJoints.size(), 1u);
+  EXPECT_EQ(r.redundantJoints[0].name, "plantar");
+  EXPECT_EQ(r.passiveDof, 1);
+  ASSERT_EQ(r.passiveMotions.size(), 1u);
+  EXPECT_EQ(r.passiveMotions[0].links, std::vector<std::string>{"achilles_rod"});
 }
 
 TEST(Readers, UrdfPlusLoopIsReadLikeALoopJoint) {
@@ -372,8 +427,14 @@ TEST(Warnings, EveryClassFiresAndNamesItsElement) {
   <joint name="jb" type="continuous"><parent link="g"/><child link="b"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
   <loop name="l" type="spherical"><predecessor link="a"/><successor link="b"/><successor link="g"/><damping/></loop>
   <coupling name="c"><predecessor joint="ja"/><successor joint="jb"/><ratio value="2"/><backlash/></coupling>
+  <link name="d"/><joint name="jd" type="prismatic"><parent link="a"/><child link="d"/></joint>
+  <loop name="hinge" type="revolute"><predecessor link="d"/><successor link="b"/></loop>
 </robot>)";
   const std::vector<std::string> wp = warningTexts(valueOf(readMechanismFromString(plus, "p.urdf")));
+  // A forgotten axis, on a tree joint or a loop whose type needs one: URDF's 1 0 0, said.
+  EXPECT_TRUE(anyContains(wp, "joint 'jd'", "type prismatic has no <axis>; axis defaulted to 1 0 0"));
+  EXPECT_TRUE(anyContains(wp, "loop 'hinge'", "type revolute has no <axis>; axis defaulted to 1 0 0"));
+  EXPECT_FALSE(anyContains(wp, "loop 'l'", "axis")) << "a spherical loop needs no axis";
   EXPECT_TRUE(anyContains(wp, "loop 'l'", "more than one <successor>"));
   EXPECT_TRUE(anyContains(wp, "loop 'l'", "unknown child <damping>"));
   EXPECT_TRUE(anyContains(wp, "coupling 'c'", "unknown child <backlash>"));
@@ -657,4 +718,169 @@ TEST(Readers, ClosureFileNamesTypesAndFramesOfJoints) {
   const Result<Mechanism> bad = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
   ASSERT_FALSE(isOk(bad));
   EXPECT_NE(diagnosticOf(bad).what.find("1 types for 2 closed_loop pairs"), std::string::npos);
+}
+
+// --- SDFormat
+// ------------------------------------------------------------------------------------------------
+
+TEST(SdfReader, PosesFollowSdformatFrameSemantics) {
+  // four_bar.sdf: the rocker placed relative_to a <frame> and flipped, j4 posed relative to its child and its
+  // axis expressed_in the model frame. Read right, the loop's two ends meet at C (0.4, 0.3, 0) and every axis
+  // is +z in the world (read without expressed_in, j4's axis would be -z).
+  const Mechanism m = readOrFail(formatPath("four_bar.sdf"));
+  EXPECT_EQ(m.name, "four_bar_sdf");
+  EXPECT_EQ(m.links[m.rootLink].name, "world");
+  const Joint& j4 = m.joints[*m.findJoint("j4")];
+  EXPECT_EQ(j4.kind, ConnectionKind::LoopJoint);
+  EXPECT_EQ(m.joints.back().name, "j4");
+  EXPECT_EQ(m.links[j4.link1].name, "coupler");
+  EXPECT_EQ(m.links[j4.link2].name, "rocker");
+  EXPECT_EQ(m.joints[*m.findJoint("j3")].type, JointType::Continuous);
+  const LinkPoses poses = computeTreePoses(m, {});
+  EXPECT_TRUE((poses[j4.link1] * j4.frame1.translation()).isApprox(Eigen::Vector3d(0.4, 0.3, 0)));
+  EXPECT_TRUE((poses[j4.link2] * j4.frame2.translation()).isApprox(Eigen::Vector3d(0.4, 0.3, 0)));
+  for (const Joint& j : m.joints) {
+    const Eigen::Vector3d world = poses[j.link1].linear() * j.frame1.linear() * j.axis;
+    EXPECT_TRUE(world.isApprox(Eigen::Vector3d::UnitZ())) << j.name << ": " << world.transpose();
+  }
+  // The rocker's tree joint is at D, where the rocker was placed through the frame pin_d.
+  EXPECT_TRUE(poses[*m.findLink("rocker")].translation().isApprox(Eigen::Vector3d(0.4, 0, 0)));
+  // A model posed in its world: the model frame is the ground's, the five-bar closes at C.
+  const Mechanism five = readOrFail(formatPath("five_bar.sdf"));
+  const Joint& c = five.joints.back();
+  const LinkPoses p5 = computeTreePoses(five, {});
+  EXPECT_TRUE((p5[c.link1] * c.frame1.translation()).isApprox(Eigen::Vector3d(0.15, 0.35, 0)));
+  EXPECT_TRUE((p5[c.link2] * c.frame2.translation()).isApprox(Eigen::Vector3d(0.15, 0.35, 0)));
+}
+
+TEST(SdfReader, BallAndUniversalJointsInTheTreeOrClosingTheLoop) {
+  // A spatial RSUR (crank about z at A, rocker about x at D, coupler on a ball at B, closed by a universal at
+  // C) and the RUSR (universal in the tree, ball closing the loop): 6*3 - 5 - 5 - 3 - 4 = 1 = DOF, nothing
+  // redundant (general geometry; a universal keeps the coupler from spinning).
+  for (const bool universalInTree : {false, true}) {
+    SCOPED_TRACE(universalInTree ? "RUSR" : "RSUR");
+    const std::string treeType = universalInTree ? "universal" : "ball";
+    const std::string loopType = universalInTree ? "ball" : "universal";
+    const std::string axes = "<axis><xyz>0 1 0</xyz></axis><axis2><xyz>1 0 0</xyz></axis2>";
+    const std::string text = R"(<sdf version="1.9"><model name="rsur">
+  <link name="crank"/><link name="coupler"><pose>0 0.2 0 0 0 0</pose></link>
+  <link name="rocker"><pose>0.4 0 0 0 0 0</pose></link>
+  <joint name="a" type="revolute"><parent>world</parent><child>crank</child><axis><xyz>0 0 1</xyz></axis></joint>
+  <joint name="b" type=")" + treeType +
+                             R"("><parent>crank</parent><child>coupler</child>)" +
+                             (universalInTree ? axes : "") + R"(</joint>
+  <joint name="d" type="revolute"><parent>world</parent><child>rocker</child><axis><xyz>1 0 0</xyz></axis></joint>
+  <joint name="c" type=")" + loopType +
+                             R"("><parent>coupler</parent><child>rocker</child>
+    <pose>0 0.1 0.25 0 0 0</pose>)" +
+                             (universalInTree ? "" : axes) + R"(</joint></model></sdf>)";
+    const Result<Mechanism> m = readMechanismFromString(text, "rsur.sdf");
+    ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+    EXPECT_TRUE(valueOf(m).warnings.empty()) << valueOf(m).warnings.front().toString();
+    EXPECT_EQ(valueOf(m).joints[*valueOf(m).findJoint("b")].type,
+              universalInTree ? JointType::Universal : JointType::Spherical);
+    EXPECT_EQ(valueOf(m).joints.back().kind, ConnectionKind::LoopJoint);
+    const MobilityReport r = reportOf(valueOf(m), AnalysisMode::Auto);
+    EXPECT_EQ(r.mode, "spatial");
+    EXPECT_EQ(r.dof, 1);
+    EXPECT_EQ(r.grublerKutzbachDof, 1);
+    EXPECT_EQ(r.numRedundant, 0);
+  }
+}
+
+TEST(SdfReader, NeverSilentAndRefusalsAreOneLine) {
+  // Warnings: a misspelt <jiont>, a revolute without <axis>, a nested model, a second model in the world.
+  const std::string text = R"(<sdf version="1.9"><world name="w"><model name="m">
+  <link name="a"/><link name="b"><pose>1 0 0 0 0 0</pose></link>
+  <joint name="ja" type="revolute"><parent>world</parent><child>a</child><axis><xyz>0 0 1</xyz></axis></joint>
+  <joint name="jb" type="revolute"><parent>a</parent><child>b</child></joint>
+  <jiont name="closing" type="revolute"><parent>b</parent><child>a</child></jiont>
+  <model name="inner"><link name="i"/></model>
+</model><model name="other"><link name="o"/></model></world></sdf>)";
+  const Result<Mechanism> m = readMechanismFromString(text, "w.sdf");
+  ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+  const std::vector<std::string> w = warningTexts(valueOf(m));
+  EXPECT_TRUE(anyContains(w, "jiont 'closing'", "did you mean <joint>")) << ::testing::PrintToString(w);
+  EXPECT_TRUE(anyContains(w, "joint 'jb'", "has no <axis>"));
+  EXPECT_TRUE(anyContains(w, "model 'inner'", "nested model"));
+  EXPECT_TRUE(anyContains(w, "model 'other'", "only the first model"));
+  EXPECT_EQ(reportOf(valueOf(m), AnalysisMode::Auto).warnings.size(), w.size());
+  ReadOptions strict;
+  strict.strict = true;
+  const Result<Mechanism> s = readMechanismFromString(text, "w.sdf", strict);
+  ASSERT_FALSE(isOk(s));
+  EXPECT_NE(diagnosticOf(s).what.find("--strict"), std::string::npos);
+  // Refusals, each naming its element in one line.
+  const std::string head = R"(<sdf version="1.9"><model name="m"><link name="a"/><link name="b"/>
+  <joint name="ja" type="revolute"><parent>world</parent><child>a</child><axis><xyz>0 0 1</xyz></axis></joint>)";
+  struct Refusal {
+    const char* label;
+    std::string text;
+    const char* kind;
+    const char* mention;
+  };
+  const std::vector<Refusal> refusals = {
+      {"screw",
+       head +
+           R"(<joint name="jb" type="screw"><parent>a</parent><child>b</child><axis><xyz>0 0 1</xyz></axis></joint></model></sdf>)",
+       "joint", "screw"},
+      {"zero axis",
+       head +
+           R"(<joint name="jb" type="revolute"><parent>a</parent><child>b</child><axis><xyz>0 0 0</xyz></axis></joint></model></sdf>)",
+       "", "norm of the xyz vector"},  // libsdformat's own refusal, which names no element
+      {"backwards",
+       head +
+           R"(<joint name="jb" type="revolute"><parent>b</parent><child>a</child><axis><xyz>0 0 1</xyz></axis></joint></model></sdf>)",
+       "link", "not reached"},
+      {"unknown link",
+       head +
+           R"(<joint name="jb" type="revolute"><parent>a</parent><child>c&#10;x</child><axis><xyz>0 0 1</xyz></axis></joint></model></sdf>)",
+       "", "c"},
+      {"out of range",
+       head +
+           R"(<joint name="jb" type="revolute"><parent>a</parent><child>b</child><pose>1e300 0 0 0 0 0</pose><axis><xyz>0 0 1</xyz></axis></joint></model></sdf>)",
+       "joint", "range"},
+      {"not xml", "<sdf version='1.9'><model name='m'>\n<link", "", ""},
+  };
+  for (const Refusal& r : refusals) {
+    SCOPED_TRACE(r.label);
+    const Result<Mechanism> bad = readMechanismFromString(r.text, "bad.sdf");
+    ASSERT_FALSE(isOk(bad));
+    expectOneLine(diagnosticOf(bad).toString());
+    if (*r.kind != '\0')
+      EXPECT_EQ(diagnosticOf(bad).elementKind, r.kind) << diagnosticOf(bad).toString();
+    EXPECT_NE(diagnosticOf(bad).toString().find(r.mention), std::string::npos)
+        << diagnosticOf(bad).toString();
+  }
+}
+
+TEST(SdfReader, TheFrontDoorKnowsSdfByItsRootOrItsExtension) {
+  // The same four-bar from the file, from its text, and from a copy whose name ends in .sdf.
+  const std::string text = readText(formatPath("four_bar.sdf"));
+  const Result<Mechanism> fromText = readMechanismFromString(text, "robot_description");
+  ASSERT_TRUE(isOk(fromText)) << diagnosticOf(fromText).toString();
+  EXPECT_EQ(valueOf(fromText).name, "four_bar_sdf");
+  EXPECT_EQ(valueOf(fromText).file, "robot_description");
+  const Result<Mechanism> bad = readMechanism(writeTemp("empty.sdf", "<nothing/>"));
+  ASSERT_FALSE(isOk(bad));
+  EXPECT_NE(diagnosticOf(bad).toString().find("empty.sdf"), std::string::npos);
+  EXPECT_NE(diagnosticOf(bad).toString().find("libsdformat"), std::string::npos)
+      << diagnosticOf(bad).toString();
+}
+
+TEST(Warnings, AMisspeltLoopInMjcfOrAClosureFileIsNeverAnOpenTree) {
+  // MJCF: MuJoCo's schema refuses <conect> (exit 2), so the leg is never read without its plantar loop.
+  std::string mjcf = readText(formatPath("cassie_leg_mjcf.xml"));
+  mjcf = std::regex_replace(mjcf, std::regex("<connect name=\"plantar\""), "<conect name=\"plantar\"");
+  const Result<Mechanism> m = readMechanismFromString(mjcf, "leg.xml");
+  ASSERT_FALSE(isOk(m));
+  EXPECT_NE(diagnosticOf(m).what.find("conect"), std::string::npos) << diagnosticOf(m).toString();
+  expectOneLine(diagnosticOf(m).toString());
+  // Closure file: 'closed_loops' is not the key, and a closure file without closed_loop is refused.
+  ReadOptions options;
+  options.closuresFile = writeTemp("typo.yaml", "closed_loops: [['closure_A', 'closure_B']]\ntype: ['6d']\n");
+  const Result<Mechanism> y = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
+  ASSERT_FALSE(isOk(y));
+  EXPECT_NE(diagnosticOf(y).toString().find("'closed_loop': is missing"), std::string::npos)
+      << diagnosticOf(y).toString();
 }

@@ -1,5 +1,6 @@
 /// Round trips of the core <-> message conversions (STYLE.md §6); no master needed.
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "mobility_analysis/mobility_analysis.hpp"
+#include "mobility_analysis/motion/Deployment.hpp"
 #include "mobility_analysis/ros/DriveableJoints.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
 
@@ -96,6 +98,16 @@ void checkMarkers(const visualization_msgs::MarkerArray& array, const Mechanism&
   for (const Marker& m : array.markers) {
     if (m.ns == kLinksNamespace) {
       EXPECT_TRUE(sameColor(m.color, toColor(report.links[m.id].elementClass, true))) << m.id;
+    } else if (m.ns == kJointsNamespace && mechanism.joints[m.id].kind == ConnectionKind::Cable) {
+      const auto cable = std::find_if(report.cables.begin(), report.cables.end(), [&](const CableState& c) {
+        return c.name == mechanism.joints[m.id].name;
+      });
+      ASSERT_NE(cable, report.cables.end()) << "every cable is in the report";
+      bool dashed = false;
+      EXPECT_TRUE(sameColor(m.color, toCableColor(cable->state, report.joints[m.id].elementClass, dashed)))
+          << m.id;
+      EXPECT_EQ(m.type, Marker::LINE_LIST);
+      EXPECT_EQ(m.points.size() > 2, dashed) << "slack dashed, else one solid segment";
     } else if (m.ns == kJointsNamespace) {
       EXPECT_TRUE(sameColor(m.color, toColor(report.joints[m.id].elementClass, false)) ||
                   (mechanism.joints[m.id].type == JointType::Floating && m.color.a < 1.0f))
@@ -119,7 +131,230 @@ void checkMarkers(const visualization_msgs::MarkerArray& array, const Mechanism&
   }
 }
 
+// --- Deployable mast (urdf/sle_deployable_*.urdf): bars 1 m at elevation beta, unit height h = sin beta;
+// passive_k joins a unit's left foot (0, (k-1) h) to its left top (0, k h), length sin 45 deg; active_base
+// joins the ground pin (0, 0) to the slider pin (cos beta, 0). Folded beta = 10 deg, deployed 45 deg.
+
+const double kDeg = M_PI / 180.0;
+
+Analysed analyseMast(const std::string& which, bool lockActiveCables = false) {
+  const Result<Mechanism> mechanism =
+      loadMechanismFromFile(std::string(MA_URDF_DIR) + "/sle_deployable_" + which + ".urdf");
+  if (!isOk(mechanism))
+    ADD_FAILURE() << diagnosticOf(mechanism).toString();
+  AnalysisOptions options;
+  options.mode = AnalysisMode::Planar;
+  options.lockActiveCables = lockActiveCables;
+  const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+  if (!isOk(analysis))
+    ADD_FAILURE() << diagnosticOf(analysis).toString();
+  return {valueOf(mechanism), valueOf(analysis)};
+}
+
+const visualization_msgs::Marker* findMarker(const visualization_msgs::MarkerArray& array,
+                                             const std::string& ns, int id) {
+  for (const auto& m : array.markers) {
+    if (m.ns == ns && m.id == id && m.action == visualization_msgs::Marker::ADD)
+      return &m;
+  }
+  return nullptr;
+}
+
+Eigen::Vector3d toVector(const geometry_msgs::Point& p) {
+  return {p.x, p.y, p.z};
+}
+
+double saturation(const std_msgs::ColorRGBA& c) {
+  return std::max({c.r, c.g, c.b}) - std::min({c.r, c.g, c.b});
+}
+
 }  // namespace
+
+TEST(RosMessageConversion, cableColoursFollowTheirState) {
+  bool dashed = true;
+  EXPECT_TRUE(sameColor(toCableColor("taut", ElementClass::Redundant, dashed),
+                        toColor(ElementClass::Redundant, false)));
+  EXPECT_FALSE(dashed);
+  EXPECT_TRUE(sameColor(toCableColor("locked", ElementClass::Neutral, dashed),
+                        toColor(ElementClass::Neutral, false)));
+  EXPECT_FALSE(dashed);
+  const std_msgs::ColorRGBA slack = toCableColor("slack", ElementClass::Redundant, dashed);
+  EXPECT_TRUE(dashed);
+  EXPECT_LT(saturation(slack), 1e-6) << "slack is grey whatever the class";
+  const std_msgs::ColorRGBA driving = toCableColor("driving", ElementClass::Neutral, dashed);
+  EXPECT_FALSE(dashed);
+  EXPECT_GT(saturation(driving), 0.5f);
+}
+
+TEST(RosMessageConversion, slackCablesAreDashedAndTautOnesSolidAtTheirPose) {
+  for (const auto& [which, beta] :
+       {std::pair<std::string, double>{"folded", 10.0 * kDeg}, {"deployed", 45.0 * kDeg}}) {
+    SCOPED_TRACE(which);
+    const Analysed a = analyseMast(which);
+    const auto array = toMarkerArray(a.mechanism, a.analysis.assembled.poses, a.analysis.report);
+    checkMarkers(array, a.mechanism, a.analysis.report);
+    const bool taut = which == "deployed";
+    for (int k = 1; k <= 4; ++k) {
+      const std::string name = "passive_" + std::to_string(k);
+      const std::optional<int> j = a.mechanism.findJoint(name);
+      ASSERT_TRUE(j.has_value()) << name;
+      const auto* m = findMarker(array, kJointsNamespace, *j);
+      ASSERT_NE(m, nullptr) << name;
+      ASSERT_EQ(m->type, visualization_msgs::Marker::LINE_LIST);
+      // The line runs between the cable's ends, one unit height sin(beta) apart, along y.
+      const Eigen::Vector3d from = toVector(m->points.front()), to = toVector(m->points.back());
+      EXPECT_NEAR((to - from).norm(), std::sin(beta), 1e-9) << name;
+      EXPECT_NEAR(std::abs(from.x()), 0.0, 1e-9);
+      EXPECT_NEAR(std::abs(to.x()), 0.0, 1e-9);
+      if (taut) {
+        EXPECT_EQ(m->points.size(), 2u) << name << " taut: one solid segment";
+        EXPECT_GT(saturation(m->color), 0.3f) << name << " taut: in a colour";
+      } else {
+        EXPECT_GT(m->points.size(), 4u) << name << " slack: dashed";
+        EXPECT_LT(saturation(m->color), 1e-6) << name << " slack: grey";
+        // Dashes and gaps alternate along the line: no dash covers its whole length.
+        double drawn = 0.0;
+        for (size_t i = 0; i + 1 < m->points.size(); i += 2)
+          drawn += (toVector(m->points[i + 1]) - toVector(m->points[i])).norm();
+        EXPECT_LT(drawn, 0.75 * std::sin(beta));
+        EXPECT_GT(drawn, 0.4 * std::sin(beta));
+      }
+    }
+    const std::optional<int> active = a.mechanism.findJoint("active_base");
+    ASSERT_TRUE(active.has_value());
+    const auto* m = findMarker(array, kJointsNamespace, *active);
+    ASSERT_NE(m, nullptr);
+    EXPECT_EQ(m->points.size(), 2u) << "the driving cable is solid";
+    EXPECT_NEAR((toVector(m->points[1]) - toVector(m->points[0])).norm(), std::cos(beta), 1e-9);
+  }
+}
+
+TEST(RosMessageConversion, forceColoursFollowSignAndMagnitude) {
+  const std_msgs::ColorRGBA tension = toForceColor(1.0, true), compression = toForceColor(-1.0, true);
+  EXPECT_GT(tension.b, tension.r + 0.5f);
+  EXPECT_GT(compression.r, compression.b + 0.5f);
+  EXPECT_GT(toForceColor(0.5, true).b, toForceColor(0.5, true).r) << "half a tension is still blue";
+  EXPECT_GT(toForceColor(-0.5, true).r, toForceColor(-0.5, true).b) << "half a compression is still red";
+  EXPECT_GT(saturation(tension), saturation(toForceColor(0.5, true)));
+  EXPECT_GT(saturation(toForceColor(0.5, true)), saturation(toForceColor(0.05, true)));
+  EXPECT_GT(saturation(compression), saturation(toForceColor(-0.5, true)));
+  const std_msgs::ColorRGBA magnitude = toForceColor(1.0, false);
+  EXPECT_GT(magnitude.g, std::max(magnitude.r, magnitude.b) + 0.5f) << "links and joints: green";
+  EXPECT_GT(saturation(magnitude), saturation(toForceColor(0.3, false)));
+  EXPECT_TRUE(sameColor(toForceColor(7.0, true), tension)) << "clamped to [-1, 1]";
+  EXPECT_TRUE(sameColor(toForceColor(std::nan(""), false), toForceColor(0.0, false))) << "nan is no force";
+}
+
+TEST(RosMessageConversion, forcesShowAStateOfTheDeployedMastOrItsPrestress) {
+  // The deployed mast with its passive cables only: N - 1 = 3 states, not prestressable (all four cables
+  // resist the same motion). Automatic choice: state 0.
+  const Analysed free = analyseMast("deployed");
+  ASSERT_EQ(free.analysis.report.selfStress.count, 3);
+  ASSERT_FALSE(free.analysis.report.selfStress.prestressable);
+  EXPECT_NE(
+      selectForces(free.analysis.report.selfStress, kForcesAuto).title.find("state of self-stress 0 of 3"),
+      std::string::npos);
+  const ForcesSelection none = selectForces(free.analysis.report.selfStress, kForcesPrestress);
+  EXPECT_TRUE(none.forces.empty());
+  EXPECT_NE(none.title.find("no prestress"), std::string::npos);
+  EXPECT_TRUE(selectForces(free.analysis.report.selfStress, 7).forces.empty());
+  EXPECT_NE(selectForces(free.analysis.report.selfStress, 7).title.find("no state 7"), std::string::npos);
+
+  const auto stateMarkers =
+      toForceMarkers(free.mechanism, free.analysis.assembled.poses, free.analysis.report, kForcesAuto);
+  ASSERT_FALSE(stateMarkers.empty());
+  EXPECT_EQ(stateMarkers.front().id, 0) << "the legend first";
+  EXPECT_EQ(stateMarkers.front().type, visualization_msgs::Marker::TEXT_VIEW_FACING);
+  EXPECT_EQ(stateMarkers.size(), 1 + free.analysis.report.selfStress.states[0].elements.size())
+      << "one marker per element of the state's support";
+  // A state of self-stress of cables between stiff scissors: at least two cables pull against each other.
+  const int links = static_cast<int>(free.mechanism.links.size());
+  const int joints = static_cast<int>(free.mechanism.joints.size());
+  int cables = 0;
+  for (const auto& m : stateMarkers) {
+    if (m.id > links && m.id <= links + joints &&
+        free.mechanism.joints[m.id - 1 - links].kind == ConnectionKind::Cable) {
+      EXPECT_EQ(m.type, visualization_msgs::Marker::LINE_LIST);
+      EXPECT_EQ(m.points.size(), 2u);
+      ++cables;
+    }
+  }
+  EXPECT_GE(cables, 2);
+  const auto invalid = toForceMarkers(free.mechanism, free.analysis.assembled.poses, free.analysis.report, 7);
+  ASSERT_EQ(invalid.size(), 1u) << "only the legend, which says why";
+  EXPECT_NE(invalid.front().text.find("no state 7"), std::string::npos);
+
+  // With the active cable locked: prestressable, and the prestress puts every taut cable in tension, so every
+  // cable is drawn blue, the colour of tension.
+  const Analysed locked = analyseMast("deployed", true);
+  ASSERT_TRUE(locked.analysis.report.selfStress.prestressable);
+  EXPECT_EQ(selectForces(locked.analysis.report.selfStress, kForcesAuto).title, "prestress");
+  const auto array = toMarkerArray(locked.mechanism, locked.analysis.assembled.poses, locked.analysis.report);
+  checkMarkers(array, locked.mechanism, locked.analysis.report);
+  const int numLinks = static_cast<int>(locked.mechanism.links.size());
+  std::set<std::string> blueCables;
+  int greenLinks = 0;
+  for (const auto& m : array.markers) {
+    if (m.ns != kForcesNamespace || m.id == 0)
+      continue;
+    if (m.id >= 1 + numLinks && m.id < 1 + numLinks + static_cast<int>(locked.mechanism.joints.size())) {
+      const Joint& joint = locked.mechanism.joints[m.id - 1 - numLinks];
+      if (joint.kind == ConnectionKind::Cable) {
+        EXPECT_GT(m.color.b, m.color.r + 0.3f) << joint.name << " in tension";
+        EXPECT_EQ(m.points.size(), 2u);
+        blueCables.insert(joint.name);
+      }
+    } else if (m.id >= 1 && m.id < 1 + numLinks && m.color.g > std::max(m.color.r, m.color.b)) {
+      ++greenLinks;
+    }
+  }
+  EXPECT_EQ(blueCables,
+            (std::set<std::string>{"passive_1", "passive_2", "passive_3", "passive_4", "active_base"}));
+  EXPECT_GE(greenLinks, 1) << "the bars carry the prestress";
+}
+
+TEST(RosMessageConversion, deployResponseCarriesTheDeployment) {
+  const Result<Mechanism> mechanism =
+      loadMechanismFromFile(std::string(MA_URDF_DIR) + "/sle_deployable_folded.urdf");
+  ASSERT_TRUE(isOk(mechanism));
+  DeploymentOptions options;
+  options.cable = "active_base";
+  options.steps = 20;
+  options.analysis.mode = AnalysisMode::Planar;
+  const Result<MobilityAnalysis> deployed = deployMechanism(valueOf(mechanism), options);
+  ASSERT_TRUE(isOk(deployed)) << diagnosticOf(deployed).toString();
+  const MobilityReport& report = valueOf(deployed).report;
+  ASSERT_TRUE(report.deployment.has_value());
+  Deploy::Response response;
+  toResponse(report, response);
+  EXPECT_TRUE(response.success);
+  EXPECT_TRUE(response.message.empty());
+  // Closed form: the passive cables (length sin 45 deg) go taut at beta = 45 deg, where the base cable is
+  // cos 45 deg long; it started at cos 10 deg.
+  EXPECT_NEAR(response.initial_length, std::cos(10.0 * kDeg), 1e-12);
+  EXPECT_NEAR(response.final_length, std::cos(45.0 * kDeg), 1e-7);
+  EXPECT_EQ(response.final_dof, 0);
+  EXPECT_EQ(response.stopped_by,
+            (std::vector<std::string>{"passive_1", "passive_2", "passive_3", "passive_4"}));
+  EXPECT_EQ(response.steps, static_cast<int>(report.deployment->steps.size()));
+  ASSERT_EQ(response.active_lengths.size(), response.step_dof.size());
+  for (size_t i = 1; i < response.active_lengths.size(); ++i)
+    EXPECT_LT(response.active_lengths[i], response.active_lengths[i - 1]) << i;
+  EXPECT_EQ(response.cables.size(), 5u);
+  EXPECT_EQ(response.self_stress.count, 3);
+
+  const DeploymentInfo back = fromResponse(response);
+  EXPECT_EQ(back.cable, "active_base");
+  EXPECT_EQ(back.stoppedBy, report.deployment->stoppedBy);
+  EXPECT_EQ(back.finalLength, report.deployment->finalLength);
+  EXPECT_EQ(back.finalDof, report.deployment->finalDof);
+  EXPECT_EQ(back.reason, report.deployment->reason);
+  ASSERT_EQ(back.steps.size(), report.deployment->steps.size());
+  for (size_t i = 0; i < back.steps.size(); ++i) {
+    EXPECT_EQ(back.steps[i].activeLength, report.deployment->steps[i].activeLength);
+    EXPECT_EQ(back.steps[i].dof, report.deployment->steps[i].dof);
+  }
+}
 
 TEST(RosMessageConversion, redundancyResponseRoundTripEqualsJson) {
   for (AnalysisMode mode : {AnalysisMode::Spatial, AnalysisMode::Planar}) {

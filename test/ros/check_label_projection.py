@@ -62,6 +62,8 @@ def main():
     for m in array.markers:
         if m.action != Marker.ADD or m.type != Marker.TEXT_VIEW_FACING:
             continue
+        if m.ns == "forces":
+            continue  # hidden in rviz/mobility.rviz (launch forces:=true shows it, and the view then frames it)
         total += 1
         p = [m.pose.position.x, m.pose.position.y, m.pose.position.z]
         d = sub(p, eye)

@@ -3,7 +3,8 @@
 # under Xvfb for each model below, takes a screenshot of the whole screen and asserts that an over-constrained
 # model shows red (redundant elements, colour (1, 0, 0)) and an exactly-constrained one shows none, and that every
 # label and the title project inside rviz's 3D view with the camera mobility_viewer framed
-# (check_label_projection.py). PNGs are kept in BUILD_DIR/rviz_screenshots/.
+# (check_label_projection.py); then the deployment of the SLE mast (deployment_screenshot.sh). PNGs are kept in
+# BUILD_DIR/rviz_screenshots/.
 #
 #   test/ros/rviz_screenshot_test.sh [BUILD_DIR]      (default: build; needs a built package in BUILD_DIR/devel)
 #
@@ -138,4 +139,11 @@ for entry in "${CASES[@]}"; do
     echo "PASS rviz screenshot $name: $red red pixels in the 3D view $view, expected $([ "$expect_red" = 1 ] && echo "some" || echo "none"); $labels_summary ($png)"
   fi
 done
+# The deployment: the folded SLE mast deployed by ~deploy, forces shown (test/ros/deployment_screenshot.sh).
+if "$SOURCE_DIR/test/ros/deployment_screenshot.sh" "$OUT_DIR/deployment.png" "$BUILD_DIR" >"$OUT_DIR/deployment.log" 2>&1; then
+  tail -n 1 "$OUT_DIR/deployment.log"
+else
+  tail -n 1 "$OUT_DIR/deployment.log"
+  failures=$((failures + 1))
+fi
 exit $((failures > 0))

@@ -15,9 +15,11 @@ struct ReadOptions {
 
 /**
  * @brief The one front door of the readers: a URDF in any of our dialects (io/UrdfReader.hpp), plus a closure
- *        file if given (io/ClosureFileReader.hpp), or an MJCF model (io/MjcfReader.hpp).
+ *        file if given (io/ClosureFileReader.hpp), an MJCF model (io/MjcfReader.hpp) or an SDFormat model
+ *        (io/SdfReader.hpp).
  *
- * The format is told by the root element (`<robot>`: URDF, `<mujoco>`: MJCF), not by the extension.
+ * The format is told by the root element (`<robot>`: URDF, `<mujoco>`: MJCF, `<sdf>`: SDFormat); a `.sdf`
+ * file whose root is not `<robot>` goes to the SDFormat reader, whose parser names what is wrong.
  * @param[in] path the model file.
  * @param[in] options closure file and strictness.
  * @return The mechanism with its warnings, or a Diagnostic (in strict mode: the first warning).
@@ -25,7 +27,7 @@ struct ReadOptions {
 Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& options = {});
 
 /**
- * @brief The same from text (the node's `robot_description` and `~load_robot`): URDF or MJCF.
+ * @brief The same from text (the node's `robot_description` and `~load_robot`): URDF, MJCF or SDFormat.
  * @param[in] text the XML.
  * @param[in] sourceName shown in diagnostics ("robot_description").
  */

@@ -11,6 +11,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
+#include "mobility_analysis/Deploy.h"
 #include "mobility_analysis/GetDof.h"
 #include "mobility_analysis/GetRedundancy.h"
 #include "mobility_analysis/LoadRobot.h"
@@ -33,7 +34,9 @@ namespace mobility_analysis {
  * joint, which it does not publish), `~load_timeout` (s, default 600: a longer ~load_robot is refused),
  * `~animate` (default false: sweep the first driveable joint back and forth while no input arrives),
  * `~publish_rate` (default 10 Hz: the current joint_states is repeated so robot_state_publisher keeps tf
- * fresh; 0 publishes only on change).
+ * fresh; 0 publishes only on change), `~forces_state` (int, read at every publication: which forces the
+ * marker namespace `forces` shows, -1 the prestress, k >= 0 state of self-stress k; unset or -2: the
+ * prestress when the structure is prestressable, else state 0; a change is drawn within 1 / publish_rate).
  *
  * Threads: services run on the spinner threads of the global queue; `input_joint_states` and the animation on
  * a queue of their own. Every answer is read from an immutable State behind a shared pointer, swapped under a
@@ -91,6 +94,14 @@ class MobilityServer {
   bool getRedundancy(GetRedundancy::Request& request, GetRedundancy::Response& response);
   bool loadRobot(LoadRobot::Request& request, LoadRobot::Response& response);
   bool move(Move::Request& request, Move::Response& response);
+  /**
+   * @brief ~deploy: shortens an active cable (deployMechanism) from the state in force; each step is
+   * committed as a display state (the start's report with the step's positions, poses and cables) and
+   * published, the final state with its full analysis then stays in force.
+   */
+  bool deploy(Deploy::Request& request, Deploy::Response& response);
+  /// `~forces_state` as it is now (cached parameter); kForcesAuto when unset or invalid.
+  int forcesChoice() const;
   void onJointStates(const sensor_msgs::JointStateConstPtr& message);
   void animate();
 
@@ -111,6 +122,7 @@ class MobilityServer {
   std::string loadError_;   ///< Why nothing is served (robot_description missing or bad).
   std::mutex loadMutex_;    ///< One ~load_robot at a time.
   std::mutex motionMutex_;  ///< One state change (joint states, ~move, animation, swap) at a time.
+  std::mutex deployMutex_;  ///< One ~deploy at a time (another is refused, not queued).
   std::atomic<uint64_t> generation_{0};
   bool unreachableLogged_ = false;  ///< An unreachable input was logged in this episode (motionMutex_).
   std::atomic<double> lastInputTime_{0.0};
@@ -119,6 +131,8 @@ class MobilityServer {
   ros::ServiceServer getRedundancyServer_;
   ros::ServiceServer loadRobotServer_;
   ros::ServiceServer moveServer_;
+  ros::ServiceServer deployServer_;
+  std::atomic<int> publishedForces_{-2};  ///< The forces choice of the last published markers.
   ros::Publisher markerPublisher_;
   ros::Publisher jointStatePublisher_;
   ros::Publisher tfStaticPublisher_;

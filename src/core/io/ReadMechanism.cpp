@@ -9,6 +9,7 @@
 #include "mobility_analysis/io/ClosureFileReader.hpp"
 #include "mobility_analysis/io/LengthRange.hpp"
 #include "mobility_analysis/io/MjcfReader.hpp"
+#include "mobility_analysis/io/SdfReader.hpp"
 #include "mobility_analysis/io/UrdfReader.hpp"
 
 namespace mobility_analysis {
@@ -88,8 +89,11 @@ Result<Mechanism> readMjcfText(const std::string& text, const std::string& sourc
 
 Result<Mechanism> readMechanismFromString(const std::string& text, const std::string& sourceName,
                                           const ReadOptions& options) {
-  if (rootElement(text) == "mujoco")
+  const std::string root = rootElement(text);
+  if (root == "mujoco")
     return finish(readMjcfText(text, sourceName), options);
+  if (root == "sdf")
+    return finish(readSdf(text, sourceName), options);
   return finish(readUrdf(text, sourceName), options);
 }
 
@@ -100,8 +104,12 @@ Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& opti
   std::stringstream text;
   text << stream.rdbuf();
   const std::string content = text.str();
-  if (rootElement(content) == "mujoco")
+  const std::string root = rootElement(content);
+  if (root == "mujoco")
     return finish(readMjcf(path), options);
+  const bool sdfExtension = path.size() >= 4 && path.compare(path.size() - 4, 4, ".sdf") == 0;
+  if (root == "sdf" || (sdfExtension && root != "robot"))
+    return finish(readSdf(content, path), options);
   return finish(readUrdf(content, path), options);
 }
 

@@ -57,9 +57,9 @@ std::optional<JointType> parseJointType(const std::string& type, std::initialize
 
 /// Loop elements take every type of the dialect but the URDF tree's own planar and floating.
 std::optional<JointType> parseLoopType(const std::string& type) {
-  return parseJointType(type, {JointType::Revolute, JointType::Continuous, JointType::Prismatic,
-                               JointType::Cylindrical, JointType::Spherical, JointType::Universal,
-                               JointType::Fixed});
+  return parseJointType(
+      type, {JointType::Revolute, JointType::Continuous, JointType::Prismatic, JointType::Cylindrical,
+             JointType::Spherical, JointType::Universal, JointType::Fixed});
 }
 
 /// Tree joints take URDF's types.
@@ -296,8 +296,15 @@ class Reader {
             io_detail::makeOriginFrame(vector(origin->Attribute("xyz"), "joint", name, "origin xyz"),
                                        vector(origin->Attribute("rpy"), "joint", name, "origin rpy"));
       }
-      if (joint.type != JointType::Fixed && joint.type != JointType::Floating)
+      if (joint.type != JointType::Fixed && joint.type != JointType::Floating) {
+        // URDF's default, but a forgotten axis turns a planar linkage spatial: said, never silent.
+        if (e->FirstChildElement("axis") == nullptr) {
+          warn("joint", name,
+               std::string("type ") + toString(joint.type) +
+                   " has no <axis>; axis defaulted to 1 0 0 (URDF's default)");
+        }
         joint.axis = axis(e, "axis", "joint", name, Eigen::Vector3d::UnitX());
+      }
       if (const tinyxml2::XMLElement* mimic = e->FirstChildElement("mimic")) {
         PendingCoupling coupling;
         coupling.name = "mimic_" + name;
