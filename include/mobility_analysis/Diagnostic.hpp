@@ -53,9 +53,15 @@ const Diagnostic& diagnosticOf(const Result<T>& result) {
 
 /**
  * @brief Escapes what would break a one-line message: newline, carriage return and tab as \\n, \\r, \\t,
- *        every other control character (and DEL) as \\xNN. Other bytes (UTF-8 included) pass unchanged.
+ *        every other control character (and DEL) as \\xNN, and so is every byte that is not part of a valid
+ *        UTF-8 sequence (the line stays valid UTF-8 text, as ROS strings and JSON need). Valid UTF-8 passes
+ *        unchanged.
  */
 std::string escapeForLine(const std::string& text);
+
+/// @return The length (1 to 4) of the valid UTF-8 sequence starting at byte @p at of @p text, 0 when the bytes
+///         there are not one (a stray continuation byte, an overlong form, a surrogate, beyond U+10FFFF, cut).
+int utf8SequenceLength(const std::string& text, size_t at);
 
 /// Builds a Diagnostic in one expression.
 Diagnostic makeDiagnostic(std::string file, std::string elementKind, std::string elementName, std::string what);

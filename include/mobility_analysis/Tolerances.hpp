@@ -23,9 +23,6 @@ constexpr double kNearDecisionFactor = 100.0;
 /// Loop closure residual accepted as closed [normalised length].
 constexpr double kClosure = 1e-9;
 
-/// Maximum Newton iterations of the assembly.
-constexpr int kAssemblyMaxIterations = 50;
-
 /// The assembly closes the loops to this largest residual [normalised length / rad]; a model that
 /// cannot reach it from its pose and from any restart cannot be closed.
 constexpr double kAssemblyTarget = 1e-12;
@@ -35,9 +32,6 @@ constexpr int kClosureMaxIterations = 200;
 
 /// Continuation towards driven positions: the largest change of any joint per step [rad] or [Lc].
 constexpr double kContinuationStep = 0.05;
-
-/// A loop residual above this after assembly means the loop cannot be closed [normalised length].
-constexpr double kAssemblyFailure = 1e-6;
 
 /// Two directions of a body are independent when the sine of their angle exceeds this [-].
 constexpr double kIndependentDirection = 1e-3;
@@ -53,6 +47,17 @@ constexpr double kPlanarAxis = 1e-6;
 /// [m] or [rad]: beyond it squares overflow or lose every digit of the mechanism's own size (a coordinate of
 /// 1e155 makes the characteristic length inf). Input outside |x| <= kMaxCoordinate is refused where it enters.
 constexpr double kMaxCoordinate = 1e12;
+
+/// Largest ratio of any length of a model (joint offset, anchor, cable length) to its typical length (the
+/// median of its nonzero lengths, io/LengthRange.hpp) [-]. A four-bar with one link welded 1e9 times its size
+/// away gave DOF 3 instead of 1 (its rank decisions lost the four-bar); 1e6 keeps a factor 1000 from there.
+constexpr double kMaxRelativeLength = 1e6;
+
+/// Largest driven prismatic value, as a multiple of the characteristic length at the start [-]: the
+/// continuation moves every joint by at most kContinuationStep per step, so 1e3 takes about 2e4 steps when the
+/// other joints move with the driven one (the continuation gives up after 1e5); 1e5 Lc ran out of steps and was
+/// reported as stopped at a dead point.
+constexpr double kMaxDrivenTravel = 1e3;
 
 /// A passive cable is taut when |distance - length| is below this fraction of its length [-].
 constexpr double kCableTaut = 1e-6;

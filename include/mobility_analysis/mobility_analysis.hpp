@@ -18,6 +18,7 @@
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/UrdfLoader.hpp"
 #include "mobility_analysis/io/ClosureFileReader.hpp"
+#include "mobility_analysis/io/LengthRange.hpp"
 #include "mobility_analysis/io/MjcfReader.hpp"
 #include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/io/UrdfReader.hpp"

@@ -19,7 +19,18 @@ namespace {
 
 std::string quote(const std::string& text) {
   std::string out = "\"";
-  for (const char c : text) {
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (static_cast<unsigned char>(c) >= 0x80) {  // JSON is UTF-8: a byte outside a valid sequence is U+FFFD
+      const int length = utf8SequenceLength(text, i);
+      if (length == 0) {
+        out += "\\ufffd";
+      } else {
+        out.append(text, i, static_cast<size_t>(length));
+        i += static_cast<size_t>(length) - 1;
+      }
+      continue;
+    }
     switch (c) {
       case '"': out += "\\\""; break;
       case '\\': out += "\\\\"; break;

@@ -6,12 +6,26 @@
 #include <sstream>
 
 #include "mobility_analysis/Tolerances.hpp"
+#include "mobility_analysis/io/LengthRange.hpp"
 #include "mobility_analysis/io/UrdfReader.hpp"
 
 namespace mobility_analysis {
 
+namespace {
+
+/// The URDF reader's result, with every length checked against the model's own size.
+Result<Mechanism> checked(Result<Mechanism> mechanism) {
+  if (isOk(mechanism)) {
+    if (std::optional<Diagnostic> outOfRange = checkLengthRange(valueOf(mechanism)))
+      return *outOfRange;
+  }
+  return mechanism;
+}
+
+}  // namespace
+
 Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std::string& fileName) {
-  return readUrdf(urdfText, fileName);
+  return checked(readUrdf(urdfText, fileName));
 }
 
 Result<Mechanism> loadMechanismFromFile(const std::string& path) {
@@ -21,7 +35,7 @@ Result<Mechanism> loadMechanismFromFile(const std::string& path) {
   }
   std::stringstream text;
   text << stream.rdbuf();
-  return readUrdf(text.str(), path);
+  return checked(readUrdf(text.str(), path));
 }
 
 Result<JointPositions> makeJointPositions(const std::vector<std::string>& names,

@@ -1,4 +1,5 @@
-/// mobility_report FILE [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] [--positions j1=0.3,j2=-1]
+/// mobility_report FILE [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] [--positions
+/// j1=0.3,j2=-1]
 /// [--rank-tolerance T] [--lock-active-cables] [--deploy CABLE [--steps N] [--deploy-to LENGTH]] [--json]
 /// Prints the mobility report of a closed-loop URDF or an MJCF model, with the --positions joints held at
 /// their values; warnings go to stderr as "warning: ..." lines; on bad input one line on stderr and exit
@@ -6,10 +7,10 @@
 
 #include <chrono>
 #include <cmath>
-#include <optional>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "mobility_analysis/mobility_analysis.hpp"
@@ -25,7 +26,8 @@ int fail(const std::string& line) {
 }
 
 const char* kUsage =
-    "usage: mobility_report FILE.urdf|FILE.xml [--closures FILE.yaml] [--strict] [--mode auto|planar|spatial] "
+    "usage: mobility_report FILE.urdf|FILE.xml [--closures FILE.yaml] [--strict] [--mode "
+    "auto|planar|spatial] "
     "[--positions j1=0.3,j2=-1] [--rank-tolerance T] [--lock-active-cables] "
     "[--deploy CABLE [--steps N] [--deploy-to LENGTH]] [--json]";
 
@@ -35,92 +37,113 @@ const char* kPositionsHelp =
     "               follow by continuation from the written pose, in its assembly mode\n"
     "               (exit 2 if a value is beyond reach)";
 
+/// What the command line asks for.
+struct Arguments {
+  std::string file;
+  mobility_analysis::AnalysisMode mode = mobility_analysis::AnalysisMode::Auto;
+  std::string positionsText;
+  double rankTolerance = -1.0;
+  bool json = false;
+  mobility_analysis::ReadOptions readOptions;
+  bool lockActiveCables = false;
+  std::string deployCable;
+  int deploySteps = 100;
+  std::optional<double> deployTo;
+};
+
+/// The arguments, or how main must end without a model: --help printed (exit 0) or one error line (exit 2).
+struct ParsedArguments {
+  std::optional<Arguments> arguments;
+  int exitCode = 0;
+};
+
+ParsedArguments parseArguments(int argc, char** argv) {
+  using namespace mobility_analysis;
+  auto stop = [](int code) { return ParsedArguments{std::nullopt, code}; };
+  Arguments a;
+  std::string modeText = "auto";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
+    if (arg == "--json") {
+      a.json = true;
+    } else if (arg == "--strict") {
+      a.readOptions.strict = true;
+    } else if (arg == "--lock-active-cables") {
+      a.lockActiveCables = true;
+    } else if (arg == "--deploy" || arg == "--steps" || arg == "--deploy-to") {
+      const char* value = next();
+      if (value == nullptr)
+        return stop(fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage));
+      char* end = nullptr;
+      if (arg == "--deploy") {
+        a.deployCable = value;
+      } else if (arg == "--steps") {
+        const long steps = std::strtol(value, &end, 10);
+        if (*end != '\0' || steps < 1 || steps > 10000000)
+          return stop(
+              fail(std::string("mobility_report: --steps '") + value + "' is not a whole number >= 1"));
+        a.deploySteps = static_cast<int>(steps);
+      } else {
+        const double length = std::strtod(value, &end);
+        if (*end != '\0' || !(length >= 0.0 && std::isfinite(length)))
+          return stop(fail(std::string("mobility_report: --deploy-to '") + value + "' is not a length >= 0"));
+        a.deployTo = length;
+      }
+    } else if (arg == "--mode" || arg == "--positions" || arg == "--rank-tolerance" || arg == "--closures") {
+      const char* value = next();
+      if (value == nullptr)
+        return stop(fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage));
+      if (arg == "--mode")
+        modeText = value;
+      if (arg == "--closures")
+        a.readOptions.closuresFile = value;
+      if (arg == "--positions")
+        a.positionsText = value;
+      if (arg == "--rank-tolerance") {
+        char* end = nullptr;
+        a.rankTolerance = std::strtod(value, &end);
+        if (*end != '\0' || !(a.rankTolerance > 0.0 && a.rankTolerance < 1.0)) {
+          return stop(fail(std::string("mobility_report: --rank-tolerance '") + value +
+                           "' is not a number in (0, 1)"));
+        }
+      }
+    } else if (arg == "-h" || arg == "--help") {
+      std::cout << kUsage << "\n" << kPositionsHelp << std::endl;
+      return stop(0);
+    } else if (!arg.empty() && arg[0] == '-') {
+      return stop(fail("mobility_report: unknown option '" + arg + "'; " + kUsage));
+    } else if (a.file.empty()) {
+      a.file = arg;
+    } else {
+      return stop(
+          fail("mobility_report: more than one file given ('" + a.file + "', '" + arg + "'); " + kUsage));
+    }
+  }
+  if (a.file.empty())
+    return stop(fail(std::string("mobility_report: no model file given; ") + kUsage));
+  const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
+  if (!isOk(mode))
+    return stop(fail("mobility_report: --mode '" + modeText + "' is not one of auto, planar, spatial"));
+  a.mode = valueOf(mode);
+  return {a, 0};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace mobility_analysis;
   try {
-    std::string file, modeText = "auto", positionsText;
-    double rankTolerance = -1.0;
-    bool json = false;
-    ReadOptions readOptions;
-    bool lockActiveCables = false;
-    std::string deployCable;
-    int deploySteps = 100;
-    std::optional<double> deployTo;
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto next = [&](const std::string& option) -> const char* {
-        if (i + 1 >= argc)
-          return nullptr;
-        (void)option;
-        return argv[++i];
-      };
-      if (arg == "--json") {
-        json = true;
-      } else if (arg == "--strict") {
-        readOptions.strict = true;
-      } else if (arg == "--lock-active-cables") {
-        lockActiveCables = true;
-      } else if (arg == "--deploy" || arg == "--steps" || arg == "--deploy-to") {
-        const char* value = next(arg);
-        if (value == nullptr)
-          return fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage);
-        char* end = nullptr;
-        if (arg == "--deploy") {
-          deployCable = value;
-        } else if (arg == "--steps") {
-          const long steps = std::strtol(value, &end, 10);
-          if (*end != '\0' || steps < 1 || steps > 10000000)
-            return fail(std::string("mobility_report: --steps '") + value + "' is not a whole number >= 1");
-          deploySteps = static_cast<int>(steps);
-        } else {
-          const double length = std::strtod(value, &end);
-          if (*end != '\0' || !(length >= 0.0 && std::isfinite(length)))
-            return fail(std::string("mobility_report: --deploy-to '") + value + "' is not a length >= 0");
-          deployTo = length;
-        }
-      } else if (arg == "--mode" || arg == "--positions" || arg == "--rank-tolerance" || arg == "--closures") {
-        const char* value = next(arg);
-        if (value == nullptr)
-          return fail(std::string("mobility_report: ") + arg + " needs a value; " + kUsage);
-        if (arg == "--mode")
-          modeText = value;
-        if (arg == "--closures")
-          readOptions.closuresFile = value;
-        if (arg == "--positions")
-          positionsText = value;
-        if (arg == "--rank-tolerance") {
-          char* end = nullptr;
-          rankTolerance = std::strtod(value, &end);
-          if (*end != '\0' || !(rankTolerance > 0.0 && rankTolerance < 1.0)) {
-            return fail(std::string("mobility_report: --rank-tolerance '") + value +
-                        "' is not a number in (0, 1)");
-          }
-        }
-      } else if (arg == "-h" || arg == "--help") {
-        std::cout << kUsage << "\n" << kPositionsHelp << std::endl;
-        return 0;
-      } else if (!arg.empty() && arg[0] == '-') {
-        return fail("mobility_report: unknown option '" + arg + "'; " + kUsage);
-      } else if (file.empty()) {
-        file = arg;
-      } else {
-        return fail("mobility_report: more than one file given ('" + file + "', '" + arg + "'); " + kUsage);
-      }
-    }
-    if (file.empty())
-      return fail(std::string("mobility_report: no model file given; ") + kUsage);
-
-    const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
-    if (!isOk(mode))
-      return fail("mobility_report: --mode '" + modeText + "' is not one of auto, planar, spatial");
+    const ParsedArguments parsed = parseArguments(argc, argv);
+    if (!parsed.arguments)
+      return parsed.exitCode;
+    const Arguments& a = *parsed.arguments;
     // Long runs say where they are on stderr (stdout stays the report alone), the loading included.
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [start] {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
-    const Result<Mechanism> mechanism = readMechanism(file, readOptions);
+    const Result<Mechanism> mechanism = readMechanism(a.file, a.readOptions);
     if (!isOk(mechanism))
       return fail(diagnosticOf(mechanism).toString());
     for (const Diagnostic& warning : valueOf(mechanism).warnings)
@@ -130,10 +153,10 @@ int main(int argc, char** argv) {
                 << valueOf(mechanism).joints.size() << " connections (" << elapsed() << " s)" << std::endl;
     }
     AnalysisOptions options;
-    options.mode = valueOf(mode);
-    options.rankTolerance = rankTolerance;
-    if (!positionsText.empty()) {
-      const Result<JointPositions> positions = parseJointPositions(positionsText, valueOf(mechanism));
+    options.mode = a.mode;
+    options.rankTolerance = a.rankTolerance;
+    if (!a.positionsText.empty()) {
+      const Result<JointPositions> positions = parseJointPositions(a.positionsText, valueOf(mechanism));
       if (!isOk(positions))
         return fail(diagnosticOf(positions).toString());
       options.positions = valueOf(positions);
@@ -145,19 +168,20 @@ int main(int argc, char** argv) {
         last = fraction;
       }
     };
-    options.lockActiveCables = lockActiveCables;
+    options.lockActiveCables = a.lockActiveCables;
     DeploymentOptions deployment;
-    deployment.cable = deployCable;
-    deployment.steps = deploySteps;
-    deployment.targetLength = deployTo;
+    deployment.cable = a.deployCable;
+    deployment.steps = a.deploySteps;
+    deployment.targetLength = a.deployTo;
     deployment.analysis = options;
-    const Result<MobilityAnalysis> analysis = deployCable.empty() ? analyzeMechanism(valueOf(mechanism), options)
-                                                                  : deployMechanism(valueOf(mechanism), deployment);
+    const Result<MobilityAnalysis> analysis = a.deployCable.empty()
+                                                  ? analyzeMechanism(valueOf(mechanism), options)
+                                                  : deployMechanism(valueOf(mechanism), deployment);
     if (!isOk(analysis))
       return fail(diagnosticOf(analysis).toString());
     // The report is written only once its own invariants hold (finite numbers, consistent counts).
     const Result<std::string> out =
-        json ? writeJson(valueOf(analysis).report) : writeText(valueOf(analysis).report);
+        a.json ? writeJson(valueOf(analysis).report) : writeText(valueOf(analysis).report);
     if (!isOk(out))
       return fail(diagnosticOf(out).toString());
     std::cout << valueOf(out);

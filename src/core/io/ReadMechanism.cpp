@@ -7,6 +7,7 @@
 
 #include "XmlValues.hpp"
 #include "mobility_analysis/io/ClosureFileReader.hpp"
+#include "mobility_analysis/io/LengthRange.hpp"
 #include "mobility_analysis/io/MjcfReader.hpp"
 #include "mobility_analysis/io/SdfReader.hpp"
 #include "mobility_analysis/io/UrdfReader.hpp"
@@ -48,6 +49,8 @@ Result<Mechanism> finish(Result<Mechanism> mechanism, const ReadOptions& options
       return mechanism;
   }
   const Mechanism& m = valueOf(mechanism);
+  if (std::optional<Diagnostic> outOfRange = checkLengthRange(m))
+    return *outOfRange;
   if (options.strict && !m.warnings.empty()) {
     Diagnostic first = m.warnings.front();
     first.what += " (--strict: warnings are errors)";

@@ -6,6 +6,7 @@
 
 #include <Eigen/SVD>
 
+#include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/motion/LoopClosure.hpp"
 #include "mobility_analysis/motion/TreeCoordinates.hpp"
 
@@ -97,6 +98,15 @@ Result<DrivenMotion> followDrivenPositions(const Mechanism& mechanism, const Lin
           "is not a revolute, continuous or prismatic tree joint of '" + mechanism.name + "'");
     if (!std::isfinite(value))
       return makeDiagnostic(mechanism.file, "positions", name, "value is not finite");
+    if (joint->type == JointType::Prismatic && std::abs(value) > tolerances::kMaxDrivenTravel * lc) {
+      char what[240];
+      std::snprintf(
+          what, sizeof(what),
+          "value %.6g m is outside the accepted range |x| <= %.0f Lc = %.6g m of this model (Lc, its "
+          "characteristic length, is %.6g m)",
+          value, tolerances::kMaxDrivenTravel, tolerances::kMaxDrivenTravel * lc, lc);
+      return makeDiagnostic(mechanism.file, "positions", name, what);
+    }
     Driver driver;
     driver.joint = *j;
     driver.unknown = layout.unknownOffset[*j];
