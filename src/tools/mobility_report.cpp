@@ -26,7 +26,7 @@ int fail(const std::string& line) {
 }
 
 const char* kUsage =
-    "usage: mobility_report FILE.urdf|FILE.xml [--closures FILE.yaml] [--strict] [--mode "
+    "usage: mobility_report FILE.urdf|FILE.xml|FILE.sdf [--closures FILE.yaml] [--strict] [--mode "
     "auto|planar|spatial] "
     "[--positions j1=0.3,j2=-1] [--rank-tolerance T] [--lock-active-cables] "
     "[--deploy CABLE [--steps N] [--deploy-to LENGTH]] [--json]";
