@@ -1,5 +1,7 @@
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
 
+#include "GeneratorParts.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
@@ -11,19 +13,10 @@ namespace mobility_analysis {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
-FamilyExpectation expectation(const std::string& mode, int dof, int grubler) {
-  const int lambda = mode == "planar" ? 3 : 6;
-  return FamilyExpectation{mode, lambda, dof, grubler, dof - grubler};
-}
-
-LinkDescription link(std::string name, std::vector<Eigen::Vector3d> path = {}) {
-  LinkDescription description;
-  description.name = std::move(name);
-  description.visualPath = std::move(path);
-  return description;
-}
+using generator_parts::expectation;
+using generator_parts::HobermanRingGeometry;
+using generator_parts::kDeg;
+using generator_parts::link;
 
 std::string indexed(const char* prefix, int i) {
   return prefix + std::to_string(i);
@@ -205,29 +198,11 @@ std::vector<FamilyExpectation> expectHobermanRing(int units) {
 }
 
 MechanismDescription makeHobermanRing(int units, double openingDeg) {
-  const double arm = 0.5;
-  const double kappa = 2.0 * M_PI / units;
-  const double opening = openingDeg * kDeg;  // angle between the two bars' first arms at the kink
-  const double phase = 100 * kDeg;
-  auto rot2 = [](double angle, const Eigen::Vector2d& v) {
-    return Eigen::Vector2d(std::cos(angle) * v.x() - std::sin(angle) * v.y(),
-                           std::sin(angle) * v.x() + std::cos(angle) * v.y());
-  };
-  // Unit 0 around its kink K = 0; both bars bent the same way: u2 = −Rot(κ) u1, v2 = −Rot(κ) v1.
-  const Eigen::Vector2d u1(std::cos(phase), std::sin(phase));
-  const Eigen::Vector2d v1(std::cos(phase + opening), std::sin(phase + opening));
-  const Eigen::Vector2d a1 = arm * u1;
-  const Eigen::Vector2d b1 = arm * v1;
-  const Eigen::Vector2d a2 = -arm * rot2(kappa, u1);
-  const Eigen::Vector2d b2 = -arm * rot2(kappa, v1);
-  // Centre O of the rotation by κ taking A1 → B2 (and B1 → A2): (I − Rκ) O = B2 − Rκ A1.
-  Eigen::Matrix2d rk;
-  rk << std::cos(kappa), -std::sin(kappa), std::sin(kappa), std::cos(kappa);
-  const Eigen::Vector2d centre = (Eigen::Matrix2d::Identity() - rk).fullPivLu().solve(b2 - rk * a1);
-  auto place = [&](int j, const Eigen::Vector2d& p) {
-    const Eigen::Vector2d q = centre + rot2(j * kappa, p - centre);
-    return Eigen::Vector3d(q.x(), q.y(), 0.0);
-  };
+  // Unit 0 around its kink K = 0; both bars bent the same way: u2 = −Rot(κ) u1, v2 = −Rot(κ) v1; the rotation by
+  // κ about the centre O takes unit j to unit j + 1 (HobermanRingGeometry).
+  const HobermanRingGeometry ring(units, openingDeg);
+  const Eigen::Vector2d &a1 = ring.a1, &b1 = ring.b1, &a2 = ring.a2, &b2 = ring.b2;
+  auto place = [&](int j, const Eigen::Vector2d& p) { return ring.place(j, p); };
   auto bar = [](int j, char side) { return "bar_" + std::to_string(j) + "_" + side; };
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
 
@@ -350,32 +325,6 @@ MechanismDescription makeParallelogramGrid(int rows, int columns) {
 
 
 // ---------------------------------------------------------------------------------------------------------
-namespace {
-
-/// The point p of unit j of makeHobermanRing (its kink at 0), for cables; same formulas as the ring.
-struct RingGeometry {
-  Eigen::Vector2d a1, b1, a2, b2, centre;
-  double kappa = 0.0;
-  RingGeometry(int units, double openingDeg) {
-    const double arm = 0.5, phase = 100 * kDeg, opening = openingDeg * kDeg;
-    kappa = 2.0 * M_PI / units;
-    const Eigen::Rotation2Dd rk(kappa);
-    const Eigen::Vector2d u1(std::cos(phase), std::sin(phase));
-    const Eigen::Vector2d v1(std::cos(phase + opening), std::sin(phase + opening));
-    a1 = arm * u1;
-    b1 = arm * v1;
-    a2 = -arm * (rk * u1);
-    b2 = -arm * (rk * v1);
-    centre = (Eigen::Matrix2d::Identity() - rk.toRotationMatrix()).fullPivLu().solve(b2 - rk * a1);
-  }
-  Eigen::Vector3d place(int j, const Eigen::Vector2d& p) const {
-    const Eigen::Vector2d q = centre + Eigen::Rotation2Dd(j * kappa) * (p - centre);
-    return Eigen::Vector3d(q.x(), q.y(), 0.0);
-  }
-};
-
-}  // namespace
-
 MechanismDescription makeSleDeployableMast(int units, double elevationDeg, double deployedDeg) {
   MechanismDescription m = makeSlePlanarMast(units, elevationDeg);
   const double w = std::cos(elevationDeg * kDeg), h = std::sin(elevationDeg * kDeg);
@@ -413,8 +362,8 @@ MechanismDescription makeSleDeployableMast(int units, double elevationDeg, doubl
 
 MechanismDescription makeRingPantograph(int units, double openingDeg, double deployedOpeningDeg) {
   MechanismDescription m = makeHobermanRing(units, openingDeg);
-  const RingGeometry now(units, openingDeg), deployed(units, deployedOpeningDeg);
-  const double hoop = (deployed.place(1, Eigen::Vector2d::Zero()) - deployed.place(0, Eigen::Vector2d::Zero())).norm();
+  const HobermanRingGeometry now(units, openingDeg), deployed(units, deployedOpeningDeg);
+  const double hoop = (deployed.kink(1) - deployed.kink(0)).norm();
   char angles[120];
   std::snprintf(angles, sizeof(angles), "%g deg (deployed at %g deg)", openingDeg, deployedOpeningDeg);
   m.name = "ring_pantograph_" + std::to_string(units);
@@ -432,8 +381,8 @@ MechanismDescription makeRingPantograph(int units, double openingDeg, double dep
   auto bar = [](int j, char side) { return "bar_" + std::to_string(j) + "_" + side; };
   for (int j = 0; j < units; ++j) {
     const int next = (j + 1) % units;
-    m.cables.push_back(CableDescription{indexed("hoop_", j), bar(j, 'a'), now.place(j, Eigen::Vector2d::Zero()),
-                                        bar(next, 'a'), now.place(next, Eigen::Vector2d::Zero()), hoop, false});
+    m.cables.push_back(CableDescription{indexed("hoop_", j), bar(j, 'a'), now.kink(j),
+                                        bar(next, 'a'), now.kink(next), hoop, false});
   }
   m.cables.push_back(CableDescription{"active_unit0", bar(0, 'a'), now.place(0, now.a1), bar(0, 'b'),
                                       now.place(0, now.b1), (now.a1 - now.b1).norm(), true});

@@ -1,5 +1,7 @@
 #include "mobility_analysis/generators/ReferenceMechanisms.hpp"
 
+#include "GeneratorParts.hpp"
+
 #include <array>
 #include <cassert>
 #include <cmath>
@@ -9,7 +11,9 @@ namespace mobility_analysis {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+using generator_parts::expectation;
+using generator_parts::kDeg;
+using generator_parts::link;
 
 Eigen::Vector3d planar(double x, double y) {
   return {x, y, 0.0};
@@ -65,18 +69,6 @@ std::array<Eigen::Isometry3d, 5> bennettFrames(const Eigen::Isometry3d& base, do
   frames[4] = frames[3] * dhTransform(-theta2, 0.0, a2, alpha2);
   assert((frames[4].matrix() - base.matrix()).norm() < 1e-12 && "Bennett loop does not close");
   return frames;
-}
-
-LinkDescription link(std::string name, std::vector<Eigen::Vector3d> path = {}) {
-  LinkDescription description;
-  description.name = std::move(name);
-  description.visualPath = std::move(path);
-  return description;
-}
-
-FamilyExpectation expectation(const std::string& mode, int dof, int grubler) {
-  const int lambda = mode == "planar" ? 3 : 6;
-  return FamilyExpectation{mode, lambda, dof, grubler, dof - grubler};
 }
 
 }  // namespace

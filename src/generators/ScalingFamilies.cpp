@@ -2,6 +2,8 @@
 
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
 
+#include "GeneratorParts.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
@@ -13,46 +15,14 @@ namespace mobility_analysis {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
-FamilyExpectation expectation(const std::string& mode, int dof, int grubler) {
-  const int lambda = mode == "planar" ? 3 : 6;
-  return FamilyExpectation{mode, lambda, dof, grubler, dof - grubler};
-}
-
-LinkDescription link(std::string name, std::vector<Eigen::Vector3d> path = {}) {
-  LinkDescription description;
-  description.name = std::move(name);
-  description.visualPath = std::move(path);
-  return description;
-}
+using generator_parts::expectation;
+using generator_parts::HobermanRingGeometry;
+using generator_parts::kDeg;
+using generator_parts::link;
 
 std::string ij(const char* prefix, int i, int j) {
   return prefix + std::to_string(i) + "_" + std::to_string(j);
 }
-
-/// Where the kink and the end pins of unit j of makeHobermanRing() are (the same formulas as the ring).
-struct RingPoints {
-  Eigen::Vector2d a1, b1, a2, centre;
-  double kappa = 0.0;
-  RingPoints(int units, double openingDeg) {
-    const double arm = 0.5, phase = 100 * kDeg, opening = openingDeg * kDeg;
-    kappa = 2.0 * M_PI / units;
-    const Eigen::Rotation2Dd rk(kappa);
-    const Eigen::Vector2d u1(std::cos(phase), std::sin(phase));
-    const Eigen::Vector2d v1(std::cos(phase + opening), std::sin(phase + opening));
-    a1 = arm * u1;
-    b1 = arm * v1;
-    a2 = -arm * (rk * u1);
-    const Eigen::Vector2d b2 = -arm * (rk * v1);
-    centre = (Eigen::Matrix2d::Identity() - rk.toRotationMatrix()).fullPivLu().solve(b2 - rk * a1);
-  }
-  Eigen::Vector3d place(int j, const Eigen::Vector2d& p) const {
-    const Eigen::Vector2d q = centre + Eigen::Rotation2Dd(j * kappa) * (p - centre);
-    return Eigen::Vector3d(q.x(), q.y(), 0.0);
-  }
-  Eigen::Vector3d kink(int j) const { return place(j, Eigen::Vector2d::Zero()); }
-};
 
 }  // namespace
 
@@ -275,7 +245,7 @@ MechanismDescription makeTrussMast(int bays) {
 // ---------------------------------------------------------------------------------------------------------
 MechanismDescription makeRingPantographNet(int units, double openingDeg, double deployedOpeningDeg) {
   MechanismDescription m = makeHobermanRing(units, openingDeg);
-  const RingPoints now(units, openingDeg), deployed(units, deployedOpeningDeg);
+  const HobermanRingGeometry now(units, openingDeg), deployed(units, deployedOpeningDeg);
   const double hoop = (deployed.kink(1) - deployed.kink(0)).norm();
   const double diagonal = (deployed.place(1, deployed.a2) - deployed.kink(0)).norm();
   char angles[120];
