@@ -270,6 +270,21 @@ SelfStressInfo fromSelfStressMessage(const SelfStressSummary& message) {
   return info;
 }
 
+std::vector<CableStatus> toCableMessages(const std::vector<CableState>& cables) {
+  std::vector<CableStatus> out;
+  out.reserve(cables.size());
+  for (const CableState& c : cables) {
+    CableStatus m;
+    m.name = c.name;
+    m.type = c.type;
+    m.state = c.state;
+    m.length = c.length;
+    m.distance = c.distance;
+    out.push_back(m);
+  }
+  return out;
+}
+
 std::vector<ElementClassification> toStatusMessages(const std::vector<ElementStatus>& statuses) {
   std::vector<ElementClassification> out;
   out.reserve(statuses.size());
@@ -552,16 +567,7 @@ void toReportFields(const MobilityReport& report, Response& response) {
   response.redundant_boundaries = report.redundantBoundaries;
   response.links = toStatusMessages(report.links);
   response.joints = toStatusMessages(report.joints);
-  response.cables.clear();
-  for (const CableState& c : report.cables) {
-    CableStatus m;
-    m.name = c.name;
-    m.type = c.type;
-    m.state = c.state;
-    m.length = c.length;
-    m.distance = c.distance;
-    response.cables.push_back(m);
-  }
+  response.cables = toCableMessages(report.cables);
   response.rank_margin.tolerance = report.rankMargin.tolerance;
   response.rank_margin.smallest_kept_pivot = report.rankMargin.smallestKeptPivot;
   response.rank_margin.largest_dropped_residual = report.rankMargin.largestDroppedResidual;
@@ -639,16 +645,7 @@ void toResponse(const MobilityReport& report, Deploy::Response& response) {
       response.step_dof.push_back(step.dof);
     }
   }
-  response.cables.clear();
-  for (const CableState& c : report.cables) {
-    CableStatus m;
-    m.name = c.name;
-    m.type = c.type;
-    m.state = c.state;
-    m.length = c.length;
-    m.distance = c.distance;
-    response.cables.push_back(m);
-  }
+  response.cables = toCableMessages(report.cables);
   toSelfStressMessage(report.selfStress, response.self_stress);
 }
 
