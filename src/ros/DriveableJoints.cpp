@@ -1,6 +1,6 @@
 #include "mobility_analysis/ros/DriveableJoints.hpp"
 
-#include <Eigen/SVD>
+#include <Eigen/QR>
 
 #include "mobility_analysis/ConstraintJacobian.hpp"
 #include "mobility_analysis/Kinematics.hpp"
@@ -44,14 +44,13 @@ std::vector<std::string> findDriveableJoints(const Mechanism& mechanism, const M
   if (J.rows() == 0) {
     nullSpace = Eigen::MatrixXd::Identity(model->numCoordinates(), model->numCoordinates());
   } else {
-    Eigen::BDCSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
-    int rank = 0;
-    const double largest = svd.singularValues().size() ? svd.singularValues()(0) : 0.0;
-    for (int i = 0; i < svd.singularValues().size(); ++i) {
-      if (svd.singularValues()(i) > kNullTolerance * largest)
-        ++rank;
-    }
-    nullSpace = svd.matrixV().rightCols(model->numCoordinates() - rank);
+    // A rank-revealing QR of Jᵀ: Jᵀ P = Q R, so the last n − rank columns of Q are an orthonormal basis of the
+    // null space (the joint choice below only needs some orthonormal basis: it is invariant under rotating it).
+    // A full SVD gives the same space; its divide-and-conquer template alone cost a minute of every build.
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J.transpose());
+    qr.setThreshold(kNullTolerance);
+    const Eigen::MatrixXd orthonormal = qr.householderQ();
+    nullSpace = orthonormal.rightCols(model->numCoordinates() - static_cast<int>(qr.rank()));
   }
   const JointPositions here = computeJointPositions(mechanism, poses);
   // rates(j, i): rate of tree joint j along null vector i.
