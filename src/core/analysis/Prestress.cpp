@@ -1,6 +1,8 @@
 #include "mobility_analysis/analysis/Prestress.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <limits>
 #include <unordered_map>
 
@@ -16,21 +18,30 @@ namespace {
 constexpr double kTensionFloor = 1e-9;
 /// Above this many states the linear program is solved by the primal simplex (see findCablePrestress).
 constexpr int kPrimalStates = 1000;
+/// A local search gives up once the ball around a cable holds more equations than this,
+constexpr int kMaxBallEquations = 400;
+/// ... or more coordinates than this,
+constexpr int kMaxBallColumns = 1200;
+/// ... or after this many layers of neighbours.
+constexpr int kMaxBallLayers = 12;
+/// Relative threshold below which a reduced row (scaled to unit norm) is dependent (tolerances::kRank) [-].
+constexpr double kLocalRank = 1e-8;
+/// A dependency passes through the seed when its coefficient there is above this fraction of its largest [-].
+constexpr double kSeedShare = 1e-6;
+/// Entries of a local state below this fraction of its largest are rounding noise and dropped [-].
+constexpr double kLocalNoise = 1e-11;
+/// The sum of local states must be in equilibrium to this (|J^T y| against |J| |y|, both at most 1) [-].
+constexpr double kLocalResidual = 1e-9;
 
-}  // namespace
-
-CablePrestress findCablePrestress(const std::vector<SelfStress>& states, int numConstraints,
-                                  const std::vector<int>& cableRows) {
+/// The linear program over the states' weights (see findCablePrestress); cableIndex maps rows to cables.
+CablePrestress solvePrestressProgram(const std::vector<SelfStress>& states, int numConstraints,
+                                     const std::vector<int>& cableRows,
+                                     const std::unordered_map<int, int>& cableIndex) {
   CablePrestress result;
   const int k = static_cast<int>(states.size());
   result.weights = Eigen::VectorXd::Zero(k);
   result.multipliers = Eigen::VectorXd::Zero(numConstraints);
-  if (cableRows.empty() || k == 0)
-    return result;
-  std::unordered_map<int, int> cableIndex;
-  for (size_t c = 0; c < cableRows.size(); ++c)
-    cableIndex[cableRows[c]] = static_cast<int>(c);
-
+  result.decidedBy = PrestressMethod::LinearProgram;
   // Columns: the k weights, then t. Rows: one per cable, y_c(a) - t >= 0.
   const int numCables = static_cast<int>(cableRows.size());
   std::vector<int> rowIndices, columnIndices;
@@ -90,6 +101,291 @@ CablePrestress findCablePrestress(const std::vector<SelfStress>& states, int num
     smallest = std::min(smallest, result.multipliers(row));
   result.feasible = result.smallestTension > kTensionFloor && smallest > kTensionFloor;
   return result;
+}
+
+/// Workspace of localStressAround, sized once for the whole Jacobian.
+struct BallWorkspace {
+  std::vector<int> rowStamp, columnStamp, columnGrown, columnLocal;
+  int stamp = 0;
+};
+
+/**
+ * A state of self-stress through cable row @p seed that puts no cable in compression, from the rows near
+ * it: the ball of rows within a growing number of layers (two rows are neighbours when they share a
+ * coordinate). At each size the rows that are alone on one of their coordinates within the ball are peeled
+ * off, inwards (such a row has multiplier 0 in every state of the ball); if the seed stays, what stays is
+ * eliminated afresh in the order seed, the other rows, the other cables (each by layer). Every row that then
+ * depends on the rows before it gives a self-stress of the whole J: the rows outside the ball get 0, and
+ * each row of the ball brings all its coordinates. The first one through the seed with no cable pushed is
+ * returned, as rows and multipliers y (y^T J = 0 for J as written) with y_seed = 1; with the other cables
+ * last it is a short loop of stress that needs few cables (a braced cell: its two diagonals and four sides).
+ * Dependencies that miss the seed but pull all their cables are passed to @p found. Nothing when the ball
+ * grew past its limits first.
+ */
+std::optional<SelfStress> localStressAround(const SparseJacobian& J,
+                                            const Eigen::SparseMatrix<double, Eigen::ColMajor>& byColumn,
+                                            const Eigen::VectorXd& rowNorm, const std::vector<char>& isCable,
+                                            int seed, BallWorkspace& work,
+                                            const std::function<void(const SelfStress&)>& found) {
+  const int stamp = work.stamp++;
+  std::vector<int> ball{seed}, columns;
+  work.rowStamp[seed] = stamp;
+  size_t layerStart = 0;
+  std::vector<Eigen::Triplet<double>> triplets;  // of ball[0, tripletRows)
+  int tripletRows = 0;
+  std::vector<int> rowStart;  // row i's triplets: [rowStart[i], rowStart[i + 1])
+  for (int layer = 0; layer < kMaxBallLayers; ++layer) {
+    // Grow: every row on a coordinate of the last layer's rows.
+    const size_t layerEnd = ball.size();
+    for (size_t i = layerStart; i < layerEnd; ++i) {
+      for (SparseJacobian::InnerIterator it(J, ball[i]); it; ++it) {
+        const int column = static_cast<int>(it.col());
+        if (work.columnGrown[column] == stamp)
+          continue;
+        work.columnGrown[column] = stamp;
+        for (Eigen::SparseMatrix<double, Eigen::ColMajor>::InnerIterator c(byColumn, column); c; ++c) {
+          const int row = static_cast<int>(c.row());
+          if (work.rowStamp[row] != stamp && rowNorm(row) > 0.0) {
+            work.rowStamp[row] = stamp;
+            ball.push_back(row);
+          }
+        }
+      }
+    }
+    layerStart = layerEnd;
+    if (ball.size() == layerEnd || static_cast<int>(ball.size()) > kMaxBallEquations)
+      return std::nullopt;
+    // The ball's rows over its columns, numbered locally in order of appearance.
+    const int numRows = static_cast<int>(ball.size());
+    for (int i = tripletRows; i < numRows; ++i) {
+      rowStart.push_back(static_cast<int>(triplets.size()));
+      for (SparseJacobian::InnerIterator it(J, ball[static_cast<size_t>(i)]); it; ++it) {
+        const int column = static_cast<int>(it.col());
+        if (work.columnStamp[column] != stamp) {
+          work.columnStamp[column] = stamp;
+          work.columnLocal[column] = static_cast<int>(columns.size());
+          columns.push_back(column);
+        }
+        triplets.emplace_back(i, work.columnLocal[column], it.value());
+      }
+    }
+    tripletRows = numRows;
+    rowStart.push_back(static_cast<int>(triplets.size()));  // end of the last row, popped below
+    if (static_cast<int>(columns.size()) > kMaxBallColumns)
+      return std::nullopt;
+    // Peel: a row alone on one of its coordinates (within the ball) has multiplier 0 in every state of the
+    // ball, so it goes, and so on inwards; what stays is where the ball's states can be.
+    const size_t numColumns = columns.size();
+    std::vector<int> count(numColumns + 1, 0);  // then the start of each column's rows
+    for (const Eigen::Triplet<double>& t : triplets)
+      ++count[static_cast<size_t>(t.col())];
+    std::vector<int> columnStart(numColumns + 1, 0), columnRows(triplets.size());
+    for (size_t c = 0; c < numColumns; ++c)
+      columnStart[c + 1] = columnStart[c] + count[c];
+    {
+      std::vector<int> fill(columnStart.begin(), columnStart.end() - 1);
+      for (const Eigen::Triplet<double>& t : triplets)
+        columnRows[static_cast<size_t>(fill[static_cast<size_t>(t.col())]++)] = t.row();
+    }
+    std::vector<char> alive(static_cast<size_t>(numRows), 1);
+    std::vector<int> lonely;
+    for (size_t c = 0; c < numColumns; ++c) {
+      if (count[c] == 1)
+        lonely.push_back(columnRows[static_cast<size_t>(columnStart[c])]);
+    }
+    while (!lonely.empty()) {
+      const int i = lonely.back();
+      lonely.pop_back();
+      if (!alive[static_cast<size_t>(i)])
+        continue;
+      alive[static_cast<size_t>(i)] = 0;
+      for (int e = rowStart[static_cast<size_t>(i)]; e < rowStart[static_cast<size_t>(i) + 1]; ++e) {
+        const size_t c = static_cast<size_t>(triplets[static_cast<size_t>(e)].col());
+        if (--count[c] != 1)
+          continue;
+        for (int k = columnStart[c]; k < columnStart[c + 1]; ++k) {
+          if (alive[static_cast<size_t>(columnRows[static_cast<size_t>(k)])])
+            lonely.push_back(columnRows[static_cast<size_t>(k)]);
+        }
+      }
+    }
+    rowStart.pop_back();
+    if (!alive[0])
+      continue;  // no state through the seed yet
+    // What stays, in the order seed, other rows, other cables (each by layer).
+    std::vector<int> kept{0}, position(static_cast<size_t>(numRows), -1);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int i = 1; i < numRows; ++i) {
+        if (alive[static_cast<size_t>(i)] &&
+            bool(isCable[static_cast<size_t>(ball[static_cast<size_t>(i)])]) == (pass == 1))
+          kept.push_back(i);
+      }
+    }
+    for (size_t k = 0; k < kept.size(); ++k)
+      position[static_cast<size_t>(kept[k])] = static_cast<int>(k);
+    std::vector<Eigen::Triplet<double>> keptTriplets;
+    for (const Eigen::Triplet<double>& t : triplets) {
+      if (alive[static_cast<size_t>(t.row())])
+        keptTriplets.emplace_back(position[static_cast<size_t>(t.row())], t.col(), t.value());
+    }
+    const int numKept = static_cast<int>(kept.size());
+    SparseJacobian local(numKept, static_cast<Eigen::Index>(columns.size()));
+    local.setFromTriplets(keptTriplets.begin(), keptTriplets.end());
+    // A dependency of row i as multipliers (y^T J = 0 for J as written), signed so that its cables are in
+    // tension; nothing when it has no cable or pulls some cables and pushes others. A state through the
+    // seed has y_seed = 1.
+    auto stateOf = [&](SparseElimination& elimination, int i) -> std::optional<SelfStress> {
+      const std::optional<SelfStress> dependency =
+          elimination.traceDependency(i, elimination.multipliers(), kMaxBallEquations);
+      if (!dependency)
+        return std::nullopt;
+      double seedValue = 0.0, largest = 0.0;
+      for (const auto& [k, z] : *dependency) {
+        largest = std::max(largest, std::abs(z));
+        if (k == 0)
+          seedValue = z;
+      }
+      SelfStress stress;
+      stress.reserve(dependency->size());
+      int pulled = 0, pushed = 0;
+      for (const auto& [k, z] : *dependency) {
+        if (std::abs(z) <= kLocalNoise * largest)
+          continue;
+        const int row = ball[static_cast<size_t>(kept[static_cast<size_t>(k)])];
+        const double y = z / rowNorm(row);  // z refers to the scaled rows
+        if (isCable[static_cast<size_t>(row)])
+          (y > 0.0 ? pulled : pushed) += 1;
+        stress.emplace_back(row, y);
+      }
+      if ((pulled > 0) == (pushed > 0))
+        return std::nullopt;
+      const bool throughSeed = std::abs(seedValue) > kSeedShare * largest;
+      double unit = pulled > 0 ? 1.0 : -1.0;
+      if (throughSeed)
+        unit = seedValue / rowNorm(seed);
+      else
+        unit /= largest;
+      for (auto& entry : stress)
+        entry.second /= unit;
+      if (!throughSeed) {
+        found(stress);  // a state elsewhere in the ball: it tensions its own cables
+        return std::nullopt;
+      }
+      return stress;
+    };
+    SparseElimination elimination(static_cast<int>(columns.size()), {}, kLocalRank, true);
+    for (int k = 0; k < numKept; ++k) {
+      if (!elimination
+               .addRow(local, k, 1.0 / rowNorm(ball[static_cast<size_t>(kept[static_cast<size_t>(k)])]))
+               .dependent)
+        continue;
+      if (std::optional<SelfStress> stress = stateOf(elimination, k))
+        return stress;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Eigen::VectorXd> findLocalCablePrestress(const SparseJacobian& J,
+                                                       const std::vector<int>& cableRows) {
+  const int m = static_cast<int>(J.rows());
+  if (cableRows.empty())
+    return std::nullopt;
+  Eigen::VectorXd rowNorm(m);
+  for (int r = 0; r < m; ++r)
+    rowNorm(r) = J.row(r).norm();
+  const Eigen::SparseMatrix<double, Eigen::ColMajor> byColumn = J;
+  std::vector<char> isCable(m, 0), covered(m, 0);
+  for (int row : cableRows)
+    isCable[row] = 1;
+  BallWorkspace work;
+  work.rowStamp.assign(static_cast<size_t>(m), -1);
+  work.columnStamp.assign(static_cast<size_t>(J.cols()), -1);
+  work.columnGrown.assign(static_cast<size_t>(J.cols()), -1);
+  work.columnLocal.assign(static_cast<size_t>(J.cols()), -1);
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(m);
+  // Adds a state that tensions its cables and no cable pushed, when it tensions one not yet in tension.
+  auto accept = [&](const SelfStress& stress) {
+    bool fresh = false;
+    for (const auto& [row, value] : stress)
+      fresh =
+          fresh || (isCable[static_cast<size_t>(row)] && value > 0.0 && !covered[static_cast<size_t>(row)]);
+    if (!fresh)
+      return;
+    for (const auto& [row, value] : stress) {
+      y(row) += value;
+      if (isCable[static_cast<size_t>(row)] && value > 0.0)
+        covered[static_cast<size_t>(row)] = 1;
+    }
+  };
+  for (int seed : cableRows) {
+    if (covered[static_cast<size_t>(seed)])
+      continue;
+    if (rowNorm(seed) <= 0.0)
+      return std::nullopt;
+    const std::optional<SelfStress> stress =
+        localStressAround(J, byColumn, rowNorm, isCable, seed, work, accept);
+    if (!stress)
+      return std::nullopt;
+    accept(*stress);
+  }
+  // The sum of nonnegative-on-cables states, each cable strictly positive in one: every cable in tension.
+  const double largest = y.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0) || !std::isfinite(largest))
+    return std::nullopt;
+  y /= largest;
+  // Each state passed the elimination's threshold; the sum must also be in equilibrium, to rounding.
+  const double jScale = std::max(1.0, rowNorm.maxCoeff());
+  if ((J.transpose() * y).cwiseAbs().maxCoeff() > kLocalResidual * jScale)
+    return std::nullopt;
+  for (int row : cableRows) {
+    if (!(y(row) > kTensionFloor))
+      return std::nullopt;
+  }
+  return y;
+}
+
+CablePrestress findCablePrestress(const std::vector<SelfStress>& states, int numConstraints,
+                                  const std::vector<int>& cableRows, const SparseJacobian* J,
+                                  int localAboveStates) {
+  CablePrestress result;
+  const int k = static_cast<int>(states.size());
+  result.weights = Eigen::VectorXd::Zero(k);
+  result.multipliers = Eigen::VectorXd::Zero(numConstraints);
+  if (cableRows.empty() || k == 0)
+    return result;
+  std::unordered_map<int, int> cableIndex;
+  for (size_t c = 0; c < cableRows.size(); ++c)
+    cableIndex[cableRows[c]] = static_cast<int>(c);
+  // A cable that no state touches has multiplier 0 in every combination: no prestress, no LP needed.
+  std::vector<char> touched(cableRows.size(), 0);
+  for (const SelfStress& state : states) {
+    for (const auto& entry : state) {
+      const auto it = cableIndex.find(entry.first);
+      if (it != cableIndex.end())
+        touched[static_cast<size_t>(it->second)] = 1;
+    }
+  }
+  if (std::find(touched.begin(), touched.end(), 0) != touched.end()) {
+    result.decidedBy = PrestressMethod::UntouchedCable;
+    return result;
+  }
+  if (J != nullptr && k > localAboveStates) {
+    std::optional<Eigen::VectorXd> local = findLocalCablePrestress(*J, cableRows);
+    if (local) {
+      result.feasible = true;
+      result.decidedBy = PrestressMethod::LocalStates;
+      result.weights.resize(0);
+      result.multipliers = std::move(*local);
+      result.smallestTension = std::numeric_limits<double>::infinity();
+      for (int row : cableRows)
+        result.smallestTension = std::min(result.smallestTension, result.multipliers(row));
+      return result;
+    }
+  }
+  return solvePrestressProgram(states, numConstraints, cableRows, cableIndex);
 }
 
 }  // namespace mobility_analysis

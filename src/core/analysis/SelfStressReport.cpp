@@ -166,7 +166,7 @@ SelfStressInfo computeSelfStressInfo(const Mechanism& mechanism, const Coordinat
     info.stability = "no taut cables to prestress";
     return info;
   }
-  const CablePrestress prestress = findCablePrestress(stresses, model.numConstraints(), cableRows);
+  const CablePrestress prestress = findCablePrestress(stresses, model.numConstraints(), cableRows, &J);
   info.prestressable = prestress.feasible;
   if (!prestress.feasible) {
     info.stability = stresses.empty() ? "no state of self-stress: the taut cables cannot be pretensioned"
