@@ -1,5 +1,6 @@
 #include "mobility_analysis/MobilityReport.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -8,17 +9,20 @@ namespace mobility_analysis {
 
 const char* toString(ElementClass elementClass) {
   switch (elementClass) {
-    case ElementClass::Neutral: return "neutral";
-    case ElementClass::OverConstrainedLoop: return "over_constrained_loop";
-    case ElementClass::Redundant: return "redundant";
+    case ElementClass::Neutral:
+      return "neutral";
+    case ElementClass::OverConstrainedLoop:
+      return "over_constrained_loop";
+    case ElementClass::Redundant:
+      return "redundant";
   }
   return "unknown";
 }
 
 namespace {
 
-std::string quote(const std::string& text) {
-  std::string out = "\"";
+void appendQuoted(std::string& out, const std::string& text) {
+  out += '"';
   for (size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     if (static_cast<unsigned char>(c) >= 0x80) {  // JSON is UTF-8: a byte outside a valid sequence is U+FFFD
@@ -32,10 +36,18 @@ std::string quote(const std::string& text) {
       continue;
     }
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char escaped[8];
@@ -46,30 +58,66 @@ std::string quote(const std::string& text) {
         }
     }
   }
-  return out + "\"";
+  out += '"';
+}
+
+std::string quote(const std::string& text) {
+  std::string out;
+  appendQuoted(out, text);
+  return out;
 }
 
 /// Numbers with a fixed number of significant digits, so equal reports print equal text. JSON has no inf or
 /// nan: a non-finite number is written as null (writeJson refuses such a report before it gets here).
-std::string number(double value, int digits = 9) {
-  if (!std::isfinite(value))
-    return "null";
+/// std::to_chars in the general format with a precision is printf's %.*g in the C locale, several times
+/// faster (a report of a large grid writes millions of forces).
+void appendNumber(std::string& out, double value, int digits = 9) {
+  if (!std::isfinite(value)) {
+    out += "null";
+    return;
+  }
   char text[40];
-  std::snprintf(text, sizeof(text), "%.*g", digits, value);
-  return text;
+  const std::to_chars_result written =
+      std::to_chars(text, text + sizeof(text), value, std::chars_format::general, digits);
+  out.append(text, written.ptr);
+}
+
+std::string number(double value, int digits = 9) {
+  std::string out;
+  appendNumber(out, value, digits);
+  return out;
 }
 
 template <class T, class F>
 std::string array(const std::vector<T>& items, F&& write) {
   std::string out = "[";
   for (size_t i = 0; i < items.size(); ++i) {
-    out += (i ? ", " : "") + write(items[i]);
+    if (i)
+      out += ", ";
+    out += write(items[i]);
   }
   return out + "]";
 }
 
-std::string forceJson(const ElementForce& f) {
-  return "{\"name\": " + quote(f.name) + ", \"kind\": " + quote(f.kind) + ", \"force\": " + number(f.force) + "}";
+/// {"name": …, "kind": …, "force": …}, appended (the states of a large grid hold millions of these).
+void appendForce(std::string& out, const ElementForce& f) {
+  out += "{\"name\": ";
+  appendQuoted(out, f.name);
+  out += ", \"kind\": ";
+  appendQuoted(out, f.kind);
+  out += ", \"force\": ";
+  appendNumber(out, f.force);
+  out += '}';
+}
+
+void appendForces(std::string& out, const std::vector<ElementForce>& forces) {
+  out += '[';
+  for (size_t i = 0; i < forces.size(); ++i) {
+    if (i)
+      out += ", ";
+    appendForce(out, forces[i]);
+  }
+  out += ']';
 }
 
 std::string cableJson(const CableState& c) {
@@ -77,30 +125,33 @@ std::string cableJson(const CableState& c) {
          ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) + "}";
 }
 
-std::string selfStressJson(const SelfStressInfo& s) {
-  std::string out = "{\"count\": " + std::to_string(s.count) + ", \"mechanism_modes\": " +
-                    std::to_string(s.mechanismModes) + ", \"states_listed\": " + (s.statesListed ? "true" : "false") +
-                    ", \"states\": " +
-                    array(s.states, [](const SelfStressState& state) { return array(state.elements, forceJson); }) +
-                    ", \"taut_cables\": " + std::to_string(s.tautCables) +
-                    ", \"prestressable\": " + (s.prestressable ? "true" : "false") +
-                    ", \"prestress\": " + array(s.prestress, forceJson) +
-                    ", \"prestress_stable\": " + (s.prestressStable ? "true" : "false") +
-                    ", \"stability\": " + quote(s.stability) + "}";
-  return out;
+void appendSelfStress(std::string& out, const SelfStressInfo& s) {
+  out += "{\"count\": " + std::to_string(s.count) +
+         ", \"mechanism_modes\": " + std::to_string(s.mechanismModes) +
+         ", \"states_listed\": " + (s.statesListed ? "true" : "false") + ", \"states\": [";
+  for (size_t i = 0; i < s.states.size(); ++i) {
+    if (i)
+      out += ", ";
+    appendForces(out, s.states[i].elements);
+  }
+  out += "], \"taut_cables\": " + std::to_string(s.tautCables) +
+         ", \"prestressable\": " + (s.prestressable ? "true" : "false") + ", \"prestress\": ";
+  appendForces(out, s.prestress);
+  out += std::string(", \"prestress_stable\": ") + (s.prestressStable ? "true" : "false") +
+         ", \"stability\": " + quote(s.stability) + "}";
 }
 
 std::string deploymentJson(const DeploymentInfo& d) {
-  std::string out = "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
-                    ", \"target_length\": " + number(d.targetLength) + ", \"final_length\": " +
-                    number(d.finalLength, 12) + ", \"final_dof\": " + std::to_string(d.finalDof) +
-                    ", \"stopped_by\": " + array(d.stoppedBy, quote) + ", \"reason\": " + quote(d.reason) +
-                    ",\n    \"steps\": [";
+  std::string out =
+      "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
+      ", \"target_length\": " + number(d.targetLength) + ", \"final_length\": " + number(d.finalLength, 12) +
+      ", \"final_dof\": " + std::to_string(d.finalDof) + ", \"stopped_by\": " + array(d.stoppedBy, quote) +
+      ", \"reason\": " + quote(d.reason) + ",\n    \"steps\": [";
   for (size_t i = 0; i < d.steps.size(); ++i) {
     const DeploymentStep& step = d.steps[i];
-    out += std::string(i ? ",\n      " : "\n      ") + "{\"active_length\": " + number(step.activeLength, 12) +
-           ", \"dof\": " + std::to_string(step.dof) + ", \"cables\": " + array(step.cables, cableJson) +
-           ", \"joints\": {";
+    out += std::string(i ? ",\n      " : "\n      ") +
+           "{\"active_length\": " + number(step.activeLength, 12) + ", \"dof\": " + std::to_string(step.dof) +
+           ", \"cables\": " + array(step.cables, cableJson) + ", \"joints\": {";
     for (size_t j = 0; j < step.joints.size(); ++j)
       out += (j ? ", " : "") + quote(step.joints[j].name) + ": " + number(step.joints[j].value, 12);
     out += "}}";
@@ -132,41 +183,29 @@ std::string toJson(const MobilityReport& r) {
   out << "  \"singular\": " << (r.singular ? "true" : "false") << ",\n";
   out << "  \"passive_dof\": " << r.passiveDof << ",\n";
   out << "  \"output_dof\": " << r.outputDof << ",\n";
-  out << "  \"passive_motions\": "
-      << array(r.passiveMotions,
-               [](const PassiveMotion& m) {
-                 return "{\"links\": " + array(m.links, quote) + ", \"description\": " + quote(m.description) + "}";
-               })
-      << ",\n";
+  out << "  \"passive_motions\": " << array(r.passiveMotions, [](const PassiveMotion& m) {
+    return "{\"links\": " + array(m.links, quote) + ", \"description\": " + quote(m.description) + "}";
+  }) << ",\n";
   out << "  \"nullity_trace\": " << array(r.nullityTrace, [](int v) { return std::to_string(v); }) << ",\n";
-  out << "  \"redundant_constraints\": "
-      << array(r.redundantConstraints,
-               [](const RedundantConstraint& c) {
-                 return "{\"index\": " + std::to_string(c.index) + ", \"source\": " + quote(c.source) +
-                        ", \"name\": " + quote(c.name) + ", \"kind\": " + quote(c.kind) +
-                        ", \"equation\": " + quote(c.equation) + ", \"cause\": " + quote(c.cause) + "}";
-               })
-      << ",\n";
-  out << "  \"redundant_joints\": "
-      << array(r.redundantJoints,
-               [](const RedundantJoint& j) {
-                 return "{\"name\": " + quote(j.name) + ", \"redundant_equations\": " +
-                        std::to_string(j.redundantEquations) + ", \"equations\": " + std::to_string(j.equations) + "}";
-               })
-      << ",\n";
+  out << "  \"redundant_constraints\": " << array(r.redundantConstraints, [](const RedundantConstraint& c) {
+    return "{\"index\": " + std::to_string(c.index) + ", \"source\": " + quote(c.source) +
+           ", \"name\": " + quote(c.name) + ", \"kind\": " + quote(c.kind) +
+           ", \"equation\": " + quote(c.equation) + ", \"cause\": " + quote(c.cause) + "}";
+  }) << ",\n";
+  out << "  \"redundant_joints\": " << array(r.redundantJoints, [](const RedundantJoint& j) {
+    return "{\"name\": " + quote(j.name) +
+           ", \"redundant_equations\": " + std::to_string(j.redundantEquations) +
+           ", \"equations\": " + std::to_string(j.equations) + "}";
+  }) << ",\n";
   out << "  \"redundant_links\": " << array(r.redundantLinks, quote) << ",\n";
   out << "  \"redundant_links_computed\": " << (r.redundantLinksComputed ? "true" : "false") << ",\n";
   out << "  \"redundant_boundaries\": " << array(r.redundantBoundaries, quote) << ",\n";
   out << "  \"links\": " << array(r.links, statusJson) << ",\n";
   out << "  \"joints\": " << array(r.joints, statusJson) << ",\n";
-  out << "  \"cables\": "
-      << array(r.cables,
-               [](const CableState& c) {
-                 return "{\"name\": " + quote(c.name) + ", \"type\": " + quote(c.type) + ", \"state\": " +
-                        quote(c.state) + ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) +
-                        "}";
-               })
-      << ",\n";
+  out << "  \"cables\": " << array(r.cables, [](const CableState& c) {
+    return "{\"name\": " + quote(c.name) + ", \"type\": " + quote(c.type) + ", \"state\": " + quote(c.state) +
+           ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) + "}";
+  }) << ",\n";
   out << "  \"rank_margin\": {\"tolerance\": " << number(r.rankMargin.tolerance, 3)
       << ", \"smallest_kept_pivot\": " << number(r.rankMargin.smallestKeptPivot, 3)
       << ", \"largest_dropped_residual\": " << number(r.rankMargin.largestDroppedResidual, 3)
@@ -179,20 +218,25 @@ std::string toJson(const MobilityReport& r) {
     out << (i ? ", " : "") << quote(r.positions[i].name) << ": " << number(r.positions[i].value, 12);
   }
   out << "},\n";
-  out << "  \"assembly\": {\"residual\": " << number(r.assembly.residual, 3) << ", \"steps\": " << r.assembly.steps
-      << ", \"iterations\": " << r.assembly.iterations << ", \"events\": " << array(r.assembly.events, quote)
-      << "},\n";
-  out << "  \"self_stress\": " << selfStressJson(r.selfStress) << ",\n";
+  out << "  \"assembly\": {\"residual\": " << number(r.assembly.residual, 3)
+      << ", \"steps\": " << r.assembly.steps << ", \"iterations\": " << r.assembly.iterations
+      << ", \"events\": " << array(r.assembly.events, quote) << "},\n";
+  // The states can be most of the report: appended to one string, not built apart and copied in.
+  std::string text = out.str();
+  text += "  \"self_stress\": ";
+  appendSelfStress(text, r.selfStress);
+  text += ",\n";
   if (r.deployment)
-    out << "  \"deployment\": " << deploymentJson(*r.deployment) << ",\n";
-  out << "  \"warnings\": " << array(r.warnings, quote) << "\n";
-  out << "}\n";
-  return out.str();
+    text += "  \"deployment\": " + deploymentJson(*r.deployment) + ",\n";
+  text += "  \"warnings\": " + array(r.warnings, quote) + "\n";
+  text += "}\n";
+  return text;
 }
 
 std::string toText(const MobilityReport& r) {
   std::ostringstream out;
-  out << "Mechanism '" << r.robot << "' (" << r.file << "), " << r.mode << " analysis (lambda = " << r.lambda << ")\n";
+  out << "Mechanism '" << r.robot << "' (" << r.file << "), " << r.mode << " analysis (lambda = " << r.lambda
+      << ")\n";
   out << "  degrees of freedom (nullity of the constraint Jacobian): " << r.dof << "\n";
   out << "  Grubler-Kutzbach count:                                  " << r.grublerKutzbachDof << "\n";
   out << "  finite DOF (how it really moves near this pose):          " << r.finiteDof
@@ -202,16 +246,19 @@ std::string toText(const MobilityReport& r) {
   out << "  passive DOF (idle groups) " << r.passiveDof << ", output DOF " << r.outputDof << "\n";
   for (const PassiveMotion& m : r.passiveMotions)
     out << "    passive: " << m.description << "\n";
-  out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints << ", rank "
-      << r.rank << "\n";
+  out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints
+      << ", rank " << r.rank << "\n";
   out << "  Calladine-Maxwell: m = num_coordinates - rank = " << r.numCoordinates << " - " << r.rank << " = "
-      << r.selfStress.mechanismModes << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints
-      << " - " << r.rank << " = " << r.selfStress.count << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
+      << r.selfStress.mechanismModes
+      << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints << " - " << r.rank
+      << " = " << r.selfStress.count
+      << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
       << " = num_coordinates - num_constraints\n";
   out << "  redundant equations: " << r.numRedundant << " (= dof - Grubler = " << r.dof - r.grublerKutzbachDof
       << ")\n";
   for (const RedundantJoint& j : r.redundantJoints) {
-    out << "    joint " << j.name << ": " << j.redundantEquations << " of " << j.equations << " equations redundant\n";
+    out << "    joint " << j.name << ": " << j.redundantEquations << " of " << j.equations
+        << " equations redundant\n";
   }
   for (const RedundantConstraint& c : r.redundantConstraints) {
     out << "      #" << c.index << " [" << c.source << " " << c.name << ", " << c.kind << "] " << c.equation
@@ -224,21 +271,27 @@ std::string toText(const MobilityReport& r) {
   } else if (r.redundantLinks.empty()) {
     out << "none";
   }
-  for (size_t i = 0; i < r.redundantLinks.size(); ++i) out << (i ? ", " : "") << r.redundantLinks[i];
+  for (size_t i = 0; i < r.redundantLinks.size(); ++i)
+    out << (i ? ", " : "") << r.redundantLinks[i];
   out << "\n  redundant boundary (ground) constraints: ";
-  if (r.redundantBoundaries.empty()) out << "none";
-  for (size_t i = 0; i < r.redundantBoundaries.size(); ++i) out << (i ? ", " : "") << r.redundantBoundaries[i];
+  if (r.redundantBoundaries.empty())
+    out << "none";
+  for (size_t i = 0; i < r.redundantBoundaries.size(); ++i)
+    out << (i ? ", " : "") << r.redundantBoundaries[i];
   out << "\n";
   std::vector<std::string> loop;
   for (const ElementStatus& s : r.links) {
-    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
+    if (s.elementClass == ElementClass::OverConstrainedLoop)
+      loop.push_back(s.name);
   }
   for (const ElementStatus& s : r.joints) {
-    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
+    if (s.elementClass == ElementClass::OverConstrainedLoop)
+      loop.push_back(s.name);
   }
   if (!loop.empty()) {
     out << "  other members of over-constrained loops: ";
-    for (size_t i = 0; i < loop.size(); ++i) out << (i ? ", " : "") << loop[i];
+    for (size_t i = 0; i < loop.size(); ++i)
+      out << (i ? ", " : "") << loop[i];
     out << "\n";
   }
   for (const CableState& c : r.cables) {
@@ -247,28 +300,32 @@ std::string toText(const MobilityReport& r) {
   }
   if (r.deployment) {
     const DeploymentInfo& d = *r.deployment;
-    out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length " << number(d.initialLength, 6)
-        << " m -> " << number(d.finalLength, 9) << " m, final DOF " << d.finalDof << "; " << d.reason << "\n";
+    out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length "
+        << number(d.initialLength, 6) << " m -> " << number(d.finalLength, 9) << " m, final DOF "
+        << d.finalDof << "; " << d.reason << "\n";
   }
   const SelfStressInfo& s = r.selfStress;
   for (size_t k = 0; k < s.states.size() && k < 20; ++k) {
     out << "    state " << k + 1 << ":";
     for (size_t e = 0; e < s.states[k].elements.size() && e < 12; ++e)
       out << " " << s.states[k].elements[e].name << " " << number(s.states[k].elements[e].force, 3);
-    if (s.states[k].elements.size() > 12) out << " ... (" << s.states[k].elements.size() << " elements)";
+    if (s.states[k].elements.size() > 12)
+      out << " ... (" << s.states[k].elements.size() << " elements)";
     out << "\n";
   }
-  if (s.states.size() > 20 || !s.statesListed) out << "    ... (" << s.count << " states in all)\n";
+  if (s.states.size() > 20 || !s.statesListed)
+    out << "    ... (" << s.count << " states in all)\n";
   if (s.tautCables > 0) {
-    out << "  prestress: " << (s.prestressable ? "prestressable" : "NOT prestressable") << " (" << s.tautCables
-        << " taut cables)";
-    if (s.prestressable) out << ", " << (s.prestressStable ? "prestress-stable" : "not prestress-stable");
+    out << "  prestress: " << (s.prestressable ? "prestressable" : "NOT prestressable") << " ("
+        << s.tautCables << " taut cables)";
+    if (s.prestressable)
+      out << ", " << (s.prestressStable ? "prestress-stable" : "not prestress-stable");
     out << "; " << s.stability << "\n";
   }
   out << "  rank margin: smallest kept pivot " << number(r.rankMargin.smallestKeptPivot, 3)
       << ", largest dropped residual " << number(r.rankMargin.largestDroppedResidual, 3) << " (tolerance "
-      << number(r.rankMargin.tolerance, 3) << ")" << (r.rankMargin.nearTolerance ? "  WARNING: near the tolerance" : "")
-      << "\n";
+      << number(r.rankMargin.tolerance, 3) << ")"
+      << (r.rankMargin.nearTolerance ? "  WARNING: near the tolerance" : "") << "\n";
   out << "  lengths in Lc = " << number(r.characteristicLength, 6) << " m; loop closure residual "
       << number(r.closureResidualBefore, 3) << " m before assembly, " << number(r.closureResidualAfter, 3)
       << " m after\n";
@@ -322,7 +379,8 @@ std::optional<Diagnostic> checkReport(const MobilityReport& r) {
   if (!(r.characteristicLength > 0.0))
     return refuse("characteristic_length is not positive");
   if (r.rank < 0 || r.rank > r.numCoordinates || r.rank > r.numConstraints)
-    return refuse("rank " + std::to_string(r.rank) + " is outside [0, min(num_coordinates, num_constraints)]");
+    return refuse("rank " + std::to_string(r.rank) +
+                  " is outside [0, min(num_coordinates, num_constraints)]");
   if (r.numCoordinates - r.rank != r.dof) {
     return refuse("num_coordinates - rank = " + std::to_string(r.numCoordinates - r.rank) + " but dof is " +
                   std::to_string(r.dof));
