@@ -9,12 +9,9 @@ namespace mobility_analysis {
 
 const char* toString(ElementClass elementClass) {
   switch (elementClass) {
-    case ElementClass::Neutral:
-      return "neutral";
-    case ElementClass::OverConstrainedLoop:
-      return "over_constrained_loop";
-    case ElementClass::Redundant:
-      return "redundant";
+    case ElementClass::Neutral: return "neutral";
+    case ElementClass::OverConstrainedLoop: return "over_constrained_loop";
+    case ElementClass::Redundant: return "redundant";
   }
   return "unknown";
 }
@@ -36,18 +33,10 @@ void appendQuoted(std::string& out, const std::string& text) {
       continue;
     }
     switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char escaped[8];
@@ -142,16 +131,16 @@ void appendSelfStress(std::string& out, const SelfStressInfo& s) {
 }
 
 std::string deploymentJson(const DeploymentInfo& d) {
-  std::string out =
-      "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
-      ", \"target_length\": " + number(d.targetLength) + ", \"final_length\": " + number(d.finalLength, 12) +
-      ", \"final_dof\": " + std::to_string(d.finalDof) + ", \"stopped_by\": " + array(d.stoppedBy, quote) +
-      ", \"reason\": " + quote(d.reason) + ",\n    \"steps\": [";
+  std::string out = "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
+                    ", \"target_length\": " + number(d.targetLength) + ", \"final_length\": " +
+                    number(d.finalLength, 12) + ", \"final_dof\": " + std::to_string(d.finalDof) +
+                    ", \"stopped_by\": " + array(d.stoppedBy, quote) + ", \"reason\": " + quote(d.reason) +
+                    ",\n    \"steps\": [";
   for (size_t i = 0; i < d.steps.size(); ++i) {
     const DeploymentStep& step = d.steps[i];
-    out += std::string(i ? ",\n      " : "\n      ") +
-           "{\"active_length\": " + number(step.activeLength, 12) + ", \"dof\": " + std::to_string(step.dof) +
-           ", \"cables\": " + array(step.cables, cableJson) + ", \"joints\": {";
+    out += std::string(i ? ",\n      " : "\n      ") + "{\"active_length\": " + number(step.activeLength, 12) +
+           ", \"dof\": " + std::to_string(step.dof) + ", \"cables\": " + array(step.cables, cableJson) +
+           ", \"joints\": {";
     for (size_t j = 0; j < step.joints.size(); ++j)
       out += (j ? ", " : "") + quote(step.joints[j].name) + ": " + number(step.joints[j].value, 12);
     out += "}}";
@@ -183,29 +172,41 @@ std::string toJson(const MobilityReport& r) {
   out << "  \"singular\": " << (r.singular ? "true" : "false") << ",\n";
   out << "  \"passive_dof\": " << r.passiveDof << ",\n";
   out << "  \"output_dof\": " << r.outputDof << ",\n";
-  out << "  \"passive_motions\": " << array(r.passiveMotions, [](const PassiveMotion& m) {
-    return "{\"links\": " + array(m.links, quote) + ", \"description\": " + quote(m.description) + "}";
-  }) << ",\n";
+  out << "  \"passive_motions\": "
+      << array(r.passiveMotions,
+               [](const PassiveMotion& m) {
+                 return "{\"links\": " + array(m.links, quote) + ", \"description\": " + quote(m.description) + "}";
+               })
+      << ",\n";
   out << "  \"nullity_trace\": " << array(r.nullityTrace, [](int v) { return std::to_string(v); }) << ",\n";
-  out << "  \"redundant_constraints\": " << array(r.redundantConstraints, [](const RedundantConstraint& c) {
-    return "{\"index\": " + std::to_string(c.index) + ", \"source\": " + quote(c.source) +
-           ", \"name\": " + quote(c.name) + ", \"kind\": " + quote(c.kind) +
-           ", \"equation\": " + quote(c.equation) + ", \"cause\": " + quote(c.cause) + "}";
-  }) << ",\n";
-  out << "  \"redundant_joints\": " << array(r.redundantJoints, [](const RedundantJoint& j) {
-    return "{\"name\": " + quote(j.name) +
-           ", \"redundant_equations\": " + std::to_string(j.redundantEquations) +
-           ", \"equations\": " + std::to_string(j.equations) + "}";
-  }) << ",\n";
+  out << "  \"redundant_constraints\": "
+      << array(r.redundantConstraints,
+               [](const RedundantConstraint& c) {
+                 return "{\"index\": " + std::to_string(c.index) + ", \"source\": " + quote(c.source) +
+                        ", \"name\": " + quote(c.name) + ", \"kind\": " + quote(c.kind) +
+                        ", \"equation\": " + quote(c.equation) + ", \"cause\": " + quote(c.cause) + "}";
+               })
+      << ",\n";
+  out << "  \"redundant_joints\": "
+      << array(r.redundantJoints,
+               [](const RedundantJoint& j) {
+                 return "{\"name\": " + quote(j.name) + ", \"redundant_equations\": " +
+                        std::to_string(j.redundantEquations) + ", \"equations\": " + std::to_string(j.equations) + "}";
+               })
+      << ",\n";
   out << "  \"redundant_links\": " << array(r.redundantLinks, quote) << ",\n";
   out << "  \"redundant_links_computed\": " << (r.redundantLinksComputed ? "true" : "false") << ",\n";
   out << "  \"redundant_boundaries\": " << array(r.redundantBoundaries, quote) << ",\n";
   out << "  \"links\": " << array(r.links, statusJson) << ",\n";
   out << "  \"joints\": " << array(r.joints, statusJson) << ",\n";
-  out << "  \"cables\": " << array(r.cables, [](const CableState& c) {
-    return "{\"name\": " + quote(c.name) + ", \"type\": " + quote(c.type) + ", \"state\": " + quote(c.state) +
-           ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) + "}";
-  }) << ",\n";
+  out << "  \"cables\": "
+      << array(r.cables,
+               [](const CableState& c) {
+                 return "{\"name\": " + quote(c.name) + ", \"type\": " + quote(c.type) + ", \"state\": " +
+                        quote(c.state) + ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) +
+                        "}";
+               })
+      << ",\n";
   out << "  \"rank_margin\": {\"tolerance\": " << number(r.rankMargin.tolerance, 3)
       << ", \"smallest_kept_pivot\": " << number(r.rankMargin.smallestKeptPivot, 3)
       << ", \"largest_dropped_residual\": " << number(r.rankMargin.largestDroppedResidual, 3)
@@ -218,9 +219,9 @@ std::string toJson(const MobilityReport& r) {
     out << (i ? ", " : "") << quote(r.positions[i].name) << ": " << number(r.positions[i].value, 12);
   }
   out << "},\n";
-  out << "  \"assembly\": {\"residual\": " << number(r.assembly.residual, 3)
-      << ", \"steps\": " << r.assembly.steps << ", \"iterations\": " << r.assembly.iterations
-      << ", \"events\": " << array(r.assembly.events, quote) << "},\n";
+  out << "  \"assembly\": {\"residual\": " << number(r.assembly.residual, 3) << ", \"steps\": " << r.assembly.steps
+      << ", \"iterations\": " << r.assembly.iterations << ", \"events\": " << array(r.assembly.events, quote)
+      << "},\n";
   // The states can be most of the report: appended to one string, not built apart and copied in.
   std::string text = out.str();
   text += "  \"self_stress\": ";
@@ -235,8 +236,7 @@ std::string toJson(const MobilityReport& r) {
 
 std::string toText(const MobilityReport& r) {
   std::ostringstream out;
-  out << "Mechanism '" << r.robot << "' (" << r.file << "), " << r.mode << " analysis (lambda = " << r.lambda
-      << ")\n";
+  out << "Mechanism '" << r.robot << "' (" << r.file << "), " << r.mode << " analysis (lambda = " << r.lambda << ")\n";
   out << "  degrees of freedom (nullity of the constraint Jacobian): " << r.dof << "\n";
   out << "  Grubler-Kutzbach count:                                  " << r.grublerKutzbachDof << "\n";
   out << "  finite DOF (how it really moves near this pose):          " << r.finiteDof
@@ -246,19 +246,16 @@ std::string toText(const MobilityReport& r) {
   out << "  passive DOF (idle groups) " << r.passiveDof << ", output DOF " << r.outputDof << "\n";
   for (const PassiveMotion& m : r.passiveMotions)
     out << "    passive: " << m.description << "\n";
-  out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints
-      << ", rank " << r.rank << "\n";
+  out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints << ", rank "
+      << r.rank << "\n";
   out << "  Calladine-Maxwell: m = num_coordinates - rank = " << r.numCoordinates << " - " << r.rank << " = "
-      << r.selfStress.mechanismModes
-      << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints << " - " << r.rank
-      << " = " << r.selfStress.count
-      << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
+      << r.selfStress.mechanismModes << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints
+      << " - " << r.rank << " = " << r.selfStress.count << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
       << " = num_coordinates - num_constraints\n";
   out << "  redundant equations: " << r.numRedundant << " (= dof - Grubler = " << r.dof - r.grublerKutzbachDof
       << ")\n";
   for (const RedundantJoint& j : r.redundantJoints) {
-    out << "    joint " << j.name << ": " << j.redundantEquations << " of " << j.equations
-        << " equations redundant\n";
+    out << "    joint " << j.name << ": " << j.redundantEquations << " of " << j.equations << " equations redundant\n";
   }
   for (const RedundantConstraint& c : r.redundantConstraints) {
     out << "      #" << c.index << " [" << c.source << " " << c.name << ", " << c.kind << "] " << c.equation
@@ -271,27 +268,21 @@ std::string toText(const MobilityReport& r) {
   } else if (r.redundantLinks.empty()) {
     out << "none";
   }
-  for (size_t i = 0; i < r.redundantLinks.size(); ++i)
-    out << (i ? ", " : "") << r.redundantLinks[i];
+  for (size_t i = 0; i < r.redundantLinks.size(); ++i) out << (i ? ", " : "") << r.redundantLinks[i];
   out << "\n  redundant boundary (ground) constraints: ";
-  if (r.redundantBoundaries.empty())
-    out << "none";
-  for (size_t i = 0; i < r.redundantBoundaries.size(); ++i)
-    out << (i ? ", " : "") << r.redundantBoundaries[i];
+  if (r.redundantBoundaries.empty()) out << "none";
+  for (size_t i = 0; i < r.redundantBoundaries.size(); ++i) out << (i ? ", " : "") << r.redundantBoundaries[i];
   out << "\n";
   std::vector<std::string> loop;
   for (const ElementStatus& s : r.links) {
-    if (s.elementClass == ElementClass::OverConstrainedLoop)
-      loop.push_back(s.name);
+    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
   }
   for (const ElementStatus& s : r.joints) {
-    if (s.elementClass == ElementClass::OverConstrainedLoop)
-      loop.push_back(s.name);
+    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
   }
   if (!loop.empty()) {
     out << "  other members of over-constrained loops: ";
-    for (size_t i = 0; i < loop.size(); ++i)
-      out << (i ? ", " : "") << loop[i];
+    for (size_t i = 0; i < loop.size(); ++i) out << (i ? ", " : "") << loop[i];
     out << "\n";
   }
   for (const CableState& c : r.cables) {
@@ -300,32 +291,28 @@ std::string toText(const MobilityReport& r) {
   }
   if (r.deployment) {
     const DeploymentInfo& d = *r.deployment;
-    out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length "
-        << number(d.initialLength, 6) << " m -> " << number(d.finalLength, 9) << " m, final DOF "
-        << d.finalDof << "; " << d.reason << "\n";
+    out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length " << number(d.initialLength, 6)
+        << " m -> " << number(d.finalLength, 9) << " m, final DOF " << d.finalDof << "; " << d.reason << "\n";
   }
   const SelfStressInfo& s = r.selfStress;
   for (size_t k = 0; k < s.states.size() && k < 20; ++k) {
     out << "    state " << k + 1 << ":";
     for (size_t e = 0; e < s.states[k].elements.size() && e < 12; ++e)
       out << " " << s.states[k].elements[e].name << " " << number(s.states[k].elements[e].force, 3);
-    if (s.states[k].elements.size() > 12)
-      out << " ... (" << s.states[k].elements.size() << " elements)";
+    if (s.states[k].elements.size() > 12) out << " ... (" << s.states[k].elements.size() << " elements)";
     out << "\n";
   }
-  if (s.states.size() > 20 || !s.statesListed)
-    out << "    ... (" << s.count << " states in all)\n";
+  if (s.states.size() > 20 || !s.statesListed) out << "    ... (" << s.count << " states in all)\n";
   if (s.tautCables > 0) {
-    out << "  prestress: " << (s.prestressable ? "prestressable" : "NOT prestressable") << " ("
-        << s.tautCables << " taut cables)";
-    if (s.prestressable)
-      out << ", " << (s.prestressStable ? "prestress-stable" : "not prestress-stable");
+    out << "  prestress: " << (s.prestressable ? "prestressable" : "NOT prestressable") << " (" << s.tautCables
+        << " taut cables)";
+    if (s.prestressable) out << ", " << (s.prestressStable ? "prestress-stable" : "not prestress-stable");
     out << "; " << s.stability << "\n";
   }
   out << "  rank margin: smallest kept pivot " << number(r.rankMargin.smallestKeptPivot, 3)
       << ", largest dropped residual " << number(r.rankMargin.largestDroppedResidual, 3) << " (tolerance "
-      << number(r.rankMargin.tolerance, 3) << ")"
-      << (r.rankMargin.nearTolerance ? "  WARNING: near the tolerance" : "") << "\n";
+      << number(r.rankMargin.tolerance, 3) << ")" << (r.rankMargin.nearTolerance ? "  WARNING: near the tolerance" : "")
+      << "\n";
   out << "  lengths in Lc = " << number(r.characteristicLength, 6) << " m; loop closure residual "
       << number(r.closureResidualBefore, 3) << " m before assembly, " << number(r.closureResidualAfter, 3)
       << " m after\n";
@@ -379,8 +366,7 @@ std::optional<Diagnostic> checkReport(const MobilityReport& r) {
   if (!(r.characteristicLength > 0.0))
     return refuse("characteristic_length is not positive");
   if (r.rank < 0 || r.rank > r.numCoordinates || r.rank > r.numConstraints)
-    return refuse("rank " + std::to_string(r.rank) +
-                  " is outside [0, min(num_coordinates, num_constraints)]");
+    return refuse("rank " + std::to_string(r.rank) + " is outside [0, min(num_coordinates, num_constraints)]");
   if (r.numCoordinates - r.rank != r.dof) {
     return refuse("num_coordinates - rank = " + std::to_string(r.numCoordinates - r.rank) + " but dof is " +
                   std::to_string(r.dof));
