@@ -211,6 +211,9 @@ class LocalStressFinder {
         jointTaken_(mechanism.joints.size(), 0),
         columnMap_(J.cols(), -1) {}
 
+  /// Whether the ball in space is tried first (it found shorter stresses than the links' ball).
+  bool inSpaceFirst() const { return inSpaceFirst_; }
+
   /// @return The stress, or nothing when the ball grows past kLocalLimit equations first.
   std::optional<SelfStress> find(int row) {
     // Once the ball in space has found a shorter stress than the links' ball, the links' is not tried first
@@ -460,7 +463,18 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
     if (!elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent) {
       continue;
     }
-    std::optional<SelfStress> stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
+    // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
+    // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
+    std::optional<SelfStress> stress;
+    if (finder.inSpaceFirst() && futileFinds < kFutileFinds) {
+      stress = finder.find(r);
+      if (stress)
+        ++basis.locallyResolved;
+      else
+        ++futileFinds;
+    }
+    if (!stress)
+      stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
     if (!stress && futileFinds < kFutileFinds) {
       stress = finder.find(r);
       if (stress) {
