@@ -19,45 +19,19 @@ mkdir -p "$WORK" "$(dirname "$OUT")"
 export PATH="/usr/bin:$PATH"  # the pyenv python3 shim has no ROS modules
 # shellcheck disable=SC1091
 set +u; source "$BUILD_DIR/devel/setup.bash"; set -u
-export LIBGL_ALWAYS_SOFTWARE=1
 export ROS_HOME="$WORK/ros_home"
-WAIT_SECONDS=60
 
-XVFB_PID=""
-LAUNCH_PID=""
-cleanup() {
-  [ -n "$LAUNCH_PID" ] && kill -INT "$LAUNCH_PID" 2>/dev/null && wait "$LAUNCH_PID" 2>/dev/null
-  [ -n "$XVFB_PID" ] && kill "$XVFB_PID" 2>/dev/null && wait "$XVFB_PID" 2>/dev/null
-  LAUNCH_PID=""
-  XVFB_PID=""
-}
-trap cleanup EXIT
+# shellcheck source=test/ros/xvfb_session.sh
+source "$SOURCE_DIR/test/ros/xvfb_session.sh"
 
-display=""
-for n in $(seq 90 140); do
-  [ -e "/tmp/.X11-unix/X$n" ] || [ -e "/tmp/.X$n-lock" ] || { display=$n; break; }
-done
-Xvfb ":$display" -screen 0 1500x1400x24 -nolisten tcp >"$WORK/xvfb.log" 2>&1 &
-XVFB_PID=$!
-export DISPLAY=":$display"
-for _ in $(seq 1 50); do xwininfo -root >/dev/null 2>&1 && break; sleep 0.1; done
-
-port=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://localhost:$port"
+start_xvfb 1500x1400 "$WORK/xvfb.log"
 rm -f "$ROS_HOME/mobility_view.rviz"
-roslaunch -p "$port" mobility_analysis mobility.launch urdf:="$SOURCE_DIR/urdf/sle_deployable_folded.urdf" \
-  mode:=planar rviz:=true forces:=true rviz_args:="--opengl 210" >"$WORK/launch.log" 2>&1 &
-LAUNCH_PID=$!
+launch_mobility "$WORK/launch.log" urdf:="$SOURCE_DIR/urdf/sle_deployable_folded.urdf" mode:=planar rviz:=true \
+  forces:=true rviz_args:="--opengl 210"
 
 ok=0
-for _ in $(seq 1 $((WAIT_SECONDS * 2))); do
-  rosservice list 2>/dev/null | grep -q "^/mobility_server/deploy$" && { ok=1; break; }
-  sleep 0.5
-done
-for _ in $(seq 1 $((WAIT_SECONDS * 2))); do
-  xwininfo -root -tree 2>/dev/null | grep -qi "rviz" && break
-  sleep 0.5
-done
+wait_for_service /mobility_server/deploy && ok=1
+wait_for_rviz_window
 sleep 4  # rviz shows the folded mast
 import -window root "$WORK/folded.png" 2>/dev/null
 
@@ -79,21 +53,18 @@ for _ in $(seq 1 40); do
   previous=$current
 done
 
-view=$(xwininfo -root -tree 2>/dev/null | awk '/\(has no name\)/ && match($0, /[0-9]+x[0-9]+\+[-0-9]+\+[-0-9]+ +\+[-0-9]+\+[-0-9]+/) {
-         split(substr($0, RSTART, RLENGTH), f, /[x+ ]+/); if (f[1] * f[2] > best) { best = f[1] * f[2];
-         g = f[1] "x" f[2] "+" f[5] "+" f[6] } } END { print g }')
+view=$(rviz_view_geometry)
 if [ -n "$view" ]; then
   convert "$WORK/deployed.png" -crop "$view" +repage "$WORK/deployed.view.png"
 else
   cp "$WORK/deployed.png" "$WORK/deployed.view.png"
 fi
 # Blue of tension (toForceColor: b well above r and g).
-blue=$(convert "$WORK/deployed.view.png" -fx '(b > 0.6 && b > r + 0.3 && b > g + 0.2) ? 1 : 0' \
-  -format '%[fx:round(mean*w*h)]' info: 2>/dev/null || echo -1)
+blue=$(/usr/bin/python3 "$SOURCE_DIR/test/ros/count_pixels.py" "$WORK/deployed.view.png" blue || echo -1)
 # Trimmed to what differs from the background by more than the grid does, with a margin.
 convert "$WORK/deployed.view.png" -fuzz 25% -trim +repage -bordercolor 'rgb(48,48,48)' -border 24 \
   -resize '900x900>' -strip -colors 128 "PNG8:$OUT"
-cleanup
+stop_session
 size=$(stat -c %s "$OUT" 2>/dev/null || echo 0)
 if [ "$ok" = 1 ] && [ "$blue" -gt 100 ] && [ "$size" -gt 0 ] && [ "$size" -lt 200000 ]; then
   echo "PASS deployment screenshot: $blue blue pixels, $size bytes -> $OUT"

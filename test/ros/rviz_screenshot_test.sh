@@ -19,7 +19,6 @@ mkdir -p "$OUT_DIR"
 export PATH="/usr/bin:$PATH"  # the pyenv python3 shim has no ROS modules
 # shellcheck disable=SC1091
 set +u; source "$BUILD_DIR/devel/setup.bash"; set -u
-export LIBGL_ALWAYS_SOFTWARE=1
 export ROS_HOME="$OUT_DIR/ros_home"
 
 # case name | URDF | mode | expect red (1) or none (0). MA_URDF_DIR overrides where the models are read from.
@@ -33,30 +32,11 @@ CASES=(
   "hoberman_ring|$URDF_DIR/hoberman_ring.urdf|planar|1"
   "bennett_mm|$URDF_DIR/bennett_mm.urdf|auto|1"
 )
-# A pixel is "red" when it is the marker red, lit or not: strong red, little green and blue. Orange (1, 0.5, 0)
-# keeps g/r = 0.5 and the neutral grey/blue colours have large g or b, so neither counts.
-RED_FX='(r > 0.35 && g < 0.12*r+0.02 && b < 0.12*r+0.02) ? 1 : 0'
+# A pixel is "red" when it is the marker red, lit or not (test/ros/count_pixels.py says exactly what counts).
 MIN_RED_PIXELS=40   # a redundant joint or link drawn at this view covers hundreds of pixels
-WAIT_SECONDS=60
 
-XVFB_PID=""
-LAUNCH_PID=""
-cleanup() {
-  [ -n "$LAUNCH_PID" ] && kill -INT "$LAUNCH_PID" 2>/dev/null && wait "$LAUNCH_PID" 2>/dev/null
-  [ -n "$XVFB_PID" ] && kill "$XVFB_PID" 2>/dev/null && wait "$XVFB_PID" 2>/dev/null
-  LAUNCH_PID=""
-  XVFB_PID=""
-}
-trap cleanup EXIT
-
-free_display() {
-  local n
-  for n in $(seq 90 140); do
-    [ -e "/tmp/.X11-unix/X$n" ] || [ -e "/tmp/.X$n-lock" ] || { echo "$n"; return; }
-  done
-  echo 99
-}
-free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])'; }
+# shellcheck source=test/ros/xvfb_session.sh
+source "$SOURCE_DIR/test/ros/xvfb_session.sh"
 
 failures=0
 for entry in "${CASES[@]}"; do
@@ -69,29 +49,13 @@ for entry in "${CASES[@]}"; do
     continue
   fi
   rm -f "$ROS_HOME/mobility_view.rviz"
-  display=$(free_display)
-  Xvfb ":$display" -screen 0 1280x900x24 -nolisten tcp >"$OUT_DIR/$name.xvfb.log" 2>&1 &
-  XVFB_PID=$!
-  export DISPLAY=":$display"
-  for _ in $(seq 1 50); do xwininfo -root >/dev/null 2>&1 && break; sleep 0.1; done
-
-  port=$(free_port)
-  export ROS_MASTER_URI="http://localhost:$port"
-  roslaunch -p "$port" mobility_analysis mobility.launch urdf:="$urdf" mode:="$mode" rviz:=true \
-    rviz_args:="--opengl 210" >"$log" 2>&1 &
-  LAUNCH_PID=$!
-
+  start_xvfb 1280x900 "$OUT_DIR/$name.xvfb.log"
+  launch_mobility "$log" urdf:="$urdf" mode:="$mode" rviz:=true rviz_args:="--opengl 210"
   # Bounded waits: the service (the node analysed and published), then the rviz window, then frames to settle.
   ok=0
-  for _ in $(seq 1 $((WAIT_SECONDS * 2))); do
-    rosservice list 2>/dev/null | grep -q "^/mobility_server/get_dof$" && { ok=1; break; }
-    sleep 0.5
-  done
+  wait_for_service /mobility_server/get_dof && ok=1
   window=0
-  for _ in $(seq 1 $((WAIT_SECONDS * 2))); do
-    xwininfo -root -tree 2>/dev/null | grep -qi "rviz" && { window=1; break; }
-    sleep 0.5
-  done
+  wait_for_rviz_window && window=1
   # rviz draws markers once the latched array and tf arrive; wait until two screenshots 1 s apart agree.
   previous=""
   for _ in $(seq 1 30); do
@@ -102,17 +66,14 @@ for entry in "${CASES[@]}"; do
     previous=$current
   done
 
-  # Count only inside rviz's 3D view (the unnamed Ogre render window, the largest one), not the panels, whose
-  # icons have red in them. Its geometry comes from `xwininfo -tree`: "WxH+x+y  +X+Y" (absolute X, Y last).
-  view=$(xwininfo -root -tree 2>/dev/null | awk '/\(has no name\)/ && match($0, /[0-9]+x[0-9]+\+[-0-9]+\+[-0-9]+ +\+[-0-9]+\+[-0-9]+/) {
-           split(substr($0, RSTART, RLENGTH), f, /[x+ ]+/); if (f[1] * f[2] > best) { best = f[1] * f[2];
-           g = f[1] "x" f[2] "+" f[5] "+" f[6] } } END { print g }')
+  # Count only inside rviz's 3D view, not the panels, whose icons have red in them.
+  view=$(rviz_view_geometry)
   if [ -n "$view" ]; then
     convert "$png" -crop "$view" +repage "$OUT_DIR/$name.view.png" 2>/dev/null
   else
     cp "$png" "$OUT_DIR/$name.view.png"
   fi
-  red=$(convert "$OUT_DIR/$name.view.png" -fx "$RED_FX" -format '%[fx:round(mean*w*h)]' info: 2>/dev/null || echo -1)
+  red=$(/usr/bin/python3 "$SOURCE_DIR/test/ros/count_pixels.py" "$OUT_DIR/$name.view.png" red || echo -1)
   # Every label inside the 3D view, projected with the camera the viewer wrote.
   size=${view%%+*}
   [ -n "$size" ] || size=1280x900
@@ -122,7 +83,7 @@ for entry in "${CASES[@]}"; do
     labels_ok=1
   fi
   labels_summary=$(tail -n 1 "$OUT_DIR/$name.labels.txt")
-  cleanup
+  stop_session
   if [ "$ok" != 1 ] || [ "$window" != 1 ] || [ "$red" -lt 0 ]; then
     echo "FAIL rviz screenshot $name: service=$ok window=$window red=$red (see $log)"
     failures=$((failures + 1))

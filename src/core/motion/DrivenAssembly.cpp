@@ -41,11 +41,18 @@ std::string unitOf(const Joint& joint) {
   return joint.type == JointType::Prismatic ? "m" : "rad";
 }
 
+/// Singular values of the closure Jacobian, largest first. The events are only watched up to
+/// DrivenAssemblySettings::eventSearchLimit (120) unknowns, where Jacobi SVD is fast enough; BDCSVD's
+/// divide and conquer cost over a minute of compile time (three quarters of this file's) and nothing at run time.
+Eigen::VectorXd singularValues(const Eigen::MatrixXd& dense) {
+  return Eigen::JacobiSVD<Eigen::MatrixXd>(dense).singularValues();
+}
+
 /// The smallest of the leading `rank` singular values relative to the largest (0 when rank is 0).
 double conditionIndicator(const Eigen::MatrixXd& dense, int rank) {
   if (rank <= 0 || dense.size() == 0)
     return 1.0;
-  const Eigen::VectorXd sigma = Eigen::BDCSVD<Eigen::MatrixXd>(dense).singularValues();
+  const Eigen::VectorXd sigma = singularValues(dense);
   if (sigma.size() < rank || sigma(0) <= 0.0)
     return 1.0;
   return sigma(rank - 1) / sigma(0);
@@ -54,7 +61,7 @@ double conditionIndicator(const Eigen::MatrixXd& dense, int rank) {
 int numericalRank(const Eigen::MatrixXd& dense) {
   if (dense.size() == 0)
     return 0;
-  const Eigen::VectorXd sigma = Eigen::BDCSVD<Eigen::MatrixXd>(dense).singularValues();
+  const Eigen::VectorXd sigma = singularValues(dense);
   int rank = 0;
   for (int i = 0; i < sigma.size(); ++i)
     rank += sigma(i) > 1e-8 * sigma(0) ? 1 : 0;
