@@ -585,30 +585,36 @@ std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis&
   if (numStresses > 0) {
     // Y, one column per stress.
     std::vector<Eigen::Triplet<double>> triplets;
-    std::vector<int> leaves(numStresses, m);  // the stress's first row: where the upward sweep leaves it
+    std::vector<int> enters(numStresses, -1);  // the stress's last row: where the upward sweep meets it
     for (int s = 0; s < numStresses; ++s) {
       for (const auto& [row, value] : basis.stresses[s]) {
         triplets.emplace_back(row, s, value);
-        leaves[s] = std::min(leaves[s], row);
+        enters[s] = std::max(enters[s], row);
       }
     }
     SparseJacobian Y(m, numStresses);
     Y.setFromTriplets(triplets.begin(), triplets.end());
 
     // Rows from the last equation up, unscaled (the stresses are scaled instead, so a row of rounding noise
-    // stays noise); the stress that the sweep leaves first is the preferred pivot, so the fill stays local.
-    // Once every stress has its pivot the earlier rows are all independent and are not looked at: the
-    // rigid-link and tree-joint rows come first and the redundancy almost always lies after them.
+    // stays noise); the stress that the upward sweep met last is the preferred pivot. Once every stress has
+    // its pivot the earlier rows are all independent and are not looked at: the rigid-link and tree-joint
+    // rows come first and the redundancy almost always lies after them.
+    // Why the stress met last: measured on the 100 x 100 grid of continuous bars (19 800 local stresses),
+    // against the stress the sweep leaves first (its first row, the rule before), it took 0.72 s instead of
+    // 2.0 s and dropped residuals of 8e-12 instead of 3.5e-10 (which flagged the rank decision as near the
+    // tolerance); on every bundled mechanism and the chain, ring, bar-lattice, spatial-mast and truss-mast
+    // families the report is the same to the byte with either rule.
     EliminationOptions options;
     for (int r = m - 1; r >= 0; --r)
       options.rowOrder.push_back(r);
     options.rowScale = Eigen::VectorXd::Ones(m);
-    std::vector<int> byLeaving(numStresses);
-    std::iota(byLeaving.begin(), byLeaving.end(), 0);
-    std::stable_sort(byLeaving.begin(), byLeaving.end(), [&](int a, int b) { return leaves[a] > leaves[b]; });
+    std::vector<int> byEntering(numStresses);
+    std::iota(byEntering.begin(), byEntering.end(), 0);
+    std::stable_sort(byEntering.begin(), byEntering.end(),
+                     [&](int a, int b) { return enters[a] < enters[b]; });
     options.columnPriority.assign(numStresses, 0);
     for (int k = 0; k < numStresses; ++k)
-      options.columnPriority[byLeaving[k]] = k;
+      options.columnPriority[byEntering[k]] = k;
     options.stopAtFullRank = true;
     const OrderedRank echelon = computeSparseElimination(Y, tolerance, options);
     if (echelon.rank != numStresses)
