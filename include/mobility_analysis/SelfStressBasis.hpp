@@ -48,7 +48,11 @@ using ProgressCallback = std::function<void(double)>;
  * but where loops share a closing connection it runs back along the whole chain of loops; such a stress is
  * replaced by one found by the same elimination restricted to the links around the equation (a ball of
  * growing radius), which is as local as the mechanism's own loops and has the same last equation, so the
- * basis stays a basis. The sweep runs from the ground; where it fills past a budget (a long ring, whose arcs
+ * basis stays a basis. Where a ball of links is the whole mechanism at once (links through many joints: a grid
+ * of continuous bars, every bar pinned to every crossing one) the ball is taken in space instead: the rows
+ * acting within a growing radius of the equation's place (joint rows at their points, a point's rigid-link
+ * combination at the point) and the rows acting on the links they reach as a whole. The sweep runs from the
+ * ground; where it fills past a budget (a long ring, whose arcs
  * fill like chains swept from their root) the spanning tree of the sweep is taken from its leaves instead and
  * the loop-closing connections after it, and a tree is always taken from its leaves.
  * @param[in] mechanism the mechanism.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <unordered_map>
 
 namespace mobility_analysis {
 
@@ -15,6 +16,11 @@ constexpr size_t kTraceLimit = 160;
 /// The local elimination gives up on balls with more equations than this; the stress is then traced in full,
 /// as it really is global (a ring's) [equations].
 constexpr size_t kLocalLimit = 6000;
+
+/// The ball in space starts at this many times the typical spacing of the places where equations act, and
+/// grows by kSpaceGrowth each time it holds no stress for its row.
+constexpr double kSpaceStart = 2.0;
+constexpr double kSpaceGrowth = 1.5;
 
 /// Local searches that may fail in a row before the basis stops searching locally (see futileFinds).
 constexpr int kFutileFinds = 8;
@@ -50,9 +56,145 @@ struct EquationGraph {
 };
 
 /**
+ * Where each equation acts, at the pose the model was built at: a joint's equations at the points they
+ * join, a point's rigid-link combination at the point. The rest of a link's equations (those between its
+ * basis elements, its boundary) act on the link as a whole and are attached to it.
+ *
+ * Why in space: on a link through many joints (a continuous bar pinned at every crossing of a grid) every
+ * joint's equations reach every other's through the link's basis, so a ball of links is the whole mechanism
+ * after one step, while the self-stresses stay among a few neighbouring joints; their neighbourhood along the
+ * link is only visible in where they are.
+ */
+class EquationPlaces {
+ public:
+  EquationPlaces(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J)
+      : place_(J.rows(), Eigen::Vector3d::Zero()), located_(J.rows(), 0), attached_(mechanism.links.size()) {
+    std::vector<int> elementOf(J.cols(), -1);
+    for (size_t e = 0; e < model.elements.size(); ++e) {
+      for (int i = 0; i < model.dim; ++i)
+        elementOf[model.elements[e].offset + i] = static_cast<int>(e);
+    }
+    auto position = [&](int e) {
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      x.head(model.dim) = model.q0.segment(model.elements[e].offset, model.dim);
+      return x;
+    };
+    std::vector<int> seen;
+    for (int r = 0; r < J.rows(); ++r) {
+      const ConstraintEquation& eq = model.equations[r];
+      if (eq.source == EquationSource::Joint) {
+        // The mean of the points it touches (each point once).
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        int count = 0;
+        seen.clear();
+        for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
+          const int e = elementOf[it.col()];
+          if (e < 0 || !model.elements[e].isPoint || std::find(seen.begin(), seen.end(), e) != seen.end())
+            continue;
+          seen.push_back(e);
+          sum += position(e);
+          ++count;
+        }
+        if (count > 0) {
+          place_[r] = sum / count;
+          located_[r] = 1;
+        }
+      } else if (eq.source == EquationSource::Link && eq.form == EquationForm::Combination &&
+                 model.elements[eq.target].isPoint) {
+        place_[r] = position(eq.target);
+        located_[r] = 1;
+      } else {
+        attached_[eq.element].push_back(r);
+      }
+    }
+    // The typical spacing: on each link with located equations, its extent over the places it has less one.
+    std::vector<std::vector<int>> linkPlaces(mechanism.links.size());
+    for (int r = 0; r < J.rows(); ++r) {
+      if (located_[r] != 0 && model.equations[r].source == EquationSource::Link)
+        linkPlaces[model.equations[r].element].push_back(r);
+    }
+    std::vector<double> spacings;
+    for (const std::vector<int>& rows : linkPlaces) {
+      if (rows.size() < 2)
+        continue;
+      Eigen::Vector3d low = place_[rows[0]], high = low;
+      for (int r : rows) {
+        low = low.cwiseMin(place_[r]);
+        high = high.cwiseMax(place_[r]);
+      }
+      const double extent = (high - low).norm();
+      if (extent > 0.0)
+        spacings.push_back(extent / static_cast<double>(rows.size() - 1));
+    }
+    if (!spacings.empty()) {
+      std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
+      spacing_ = spacings[spacings.size() / 2];
+    } else {
+      spacing_ = model.characteristicLength > 0.0 ? model.characteristicLength : 1.0;
+    }
+    // Located rows bucketed in cubes of the spacing.
+    for (int r = 0; r < J.rows(); ++r) {
+      if (located_[r] == 0)
+        continue;
+      const Eigen::Vector3i cell = cellOf(place_[r]);
+      lowest_ = numLocated_ == 0 ? cell : lowest_.cwiseMin(cell);
+      highest_ = numLocated_ == 0 ? cell : highest_.cwiseMax(cell);
+      cells_[key(cell)].push_back(r);
+      ++numLocated_;
+    }
+  }
+
+  bool located(int row) const { return located_[row] != 0; }
+  size_t numLocated() const { return numLocated_; }
+  const Eigen::Vector3d& place(int row) const { return place_[row]; }
+  double spacing() const { return spacing_; }
+  /// Rows without a place, acting on @p link as a whole.
+  const std::vector<int>& attached(int link) const { return attached_[link]; }
+
+  /// Calls @p visit for every located row within @p radius of @p center.
+  template <class Visit>
+  void forEachWithin(const Eigen::Vector3d& center, double radius, Visit&& visit) const {
+    // Only the cells within the places' bounds (a planar model is one cell thick).
+    const Eigen::Vector3i low = cellOf(center - Eigen::Vector3d::Constant(radius)).cwiseMax(lowest_);
+    const Eigen::Vector3i high = cellOf(center + Eigen::Vector3d::Constant(radius)).cwiseMin(highest_);
+    for (int x = low.x(); x <= high.x(); ++x) {
+      for (int y = low.y(); y <= high.y(); ++y) {
+        for (int z = low.z(); z <= high.z(); ++z) {
+          const auto cell = cells_.find(key(Eigen::Vector3i(x, y, z)));
+          if (cell == cells_.end())
+            continue;
+          for (int r : cell->second) {
+            if ((place_[r] - center).squaredNorm() <= radius * radius)
+              visit(r);
+          }
+        }
+      }
+    }
+  }
+
+ private:
+  Eigen::Vector3i cellOf(const Eigen::Vector3d& x) const {
+    return (x / spacing_).array().floor().cast<int>();
+  }
+  static uint64_t key(const Eigen::Vector3i& cell) {
+    auto part = [](int v) { return static_cast<uint64_t>(static_cast<uint32_t>(v) & 0x1fffffu); };
+    return part(cell.x()) | part(cell.y()) << 21 | part(cell.z()) << 42;
+  }
+
+  std::vector<Eigen::Vector3d> place_;
+  std::vector<char> located_;
+  std::vector<std::vector<int>> attached_;
+  double spacing_ = 1.0;
+  size_t numLocated_ = 0;
+  Eigen::Vector3i lowest_ = Eigen::Vector3i::Zero(), highest_ = Eigen::Vector3i::Zero();
+  std::unordered_map<uint64_t, std::vector<int>> cells_;
+};
+
+/**
  * Finds a stress whose last equation (in sweep order) is a given row among the links within a growing radius
  * of the row's links: the sweep's elimination restricted to the rows of that ball. Workspaces are kept across
- * calls, so one call costs what its ball holds, not what the mechanism holds.
+ * calls, so one call costs what its ball holds, not what the mechanism holds. Where a ball of links is the
+ * whole mechanism at once (links through many joints), the ball is taken in space instead (EquationPlaces).
  */
 class LocalStressFinder {
  public:
@@ -69,8 +211,33 @@ class LocalStressFinder {
         jointTaken_(mechanism.joints.size(), 0),
         columnMap_(J.cols(), -1) {}
 
+  /// Whether the ball in space is tried first (it found shorter stresses than the links' ball).
+  bool inSpaceFirst() const { return inSpaceFirst_; }
+
   /// @return The stress, or nothing when the ball grows past kLocalLimit equations first.
   std::optional<SelfStress> find(int row) {
+    // Once the ball in space has found a shorter stress than the links' ball, the links' is not tried first
+    // again: on a grid of continuous bars it is the whole mechanism for every row.
+    if (inSpaceFirst_) {
+      if (std::optional<SelfStress> found = findInSpace(row))
+        return found;
+      return findAmongLinks(row);
+    }
+    std::optional<SelfStress> amongLinks = findAmongLinks(row);
+    if (amongLinks && amongLinks->size() <= kTraceLimit)
+      return amongLinks;
+    // Failed, or as long as a trace: the ball of links was most of the mechanism.
+    std::optional<SelfStress> inSpace = findInSpace(row);
+    if (inSpace && (!amongLinks || inSpace->size() < amongLinks->size())) {
+      inSpaceFirst_ = true;
+      return inSpace;
+    }
+    return amongLinks;
+  }
+
+ private:
+  /// The ball of links around the row's links.
+  std::optional<SelfStress> findAmongLinks(int row) {
     const ConstraintEquation& eq = model_.equations[row];
     ball_.clear();
     if (eq.source == EquationSource::Joint) {
@@ -109,7 +276,60 @@ class LocalStressFinder {
     return found;
   }
 
- private:
+  /// The ball in space around the row's place: the located rows within a growing radius, and the attached
+  /// rows of every link they reach.
+  std::optional<SelfStress> findInSpace(int row) {
+    if (!places_)
+      places_.emplace(mechanism_, model_, J_);
+    if (!places_->located(row))
+      return std::nullopt;
+    const Eigen::Vector3d center = places_->place(row);
+    std::vector<int> rows, links;
+    const double start = kSpaceStart * places_->spacing();
+    for (double radius = spaceRadius_ > 0.0 ? spaceRadius_ : start;; radius *= kSpaceGrowth) {
+      rows.clear();
+      links.clear();
+      size_t within = 0;
+      auto touch = [&](int link) {
+        if (inBall_[link] == 0) {
+          inBall_[link] = 1;
+          links.push_back(link);
+        }
+      };
+      places_->forEachWithin(center, radius, [&](int r) {
+        ++within;
+        if (position_[r] > position_[row])
+          return;
+        rows.push_back(r);
+        const ConstraintEquation& eq = model_.equations[r];
+        if (eq.source == EquationSource::Joint) {
+          touch(mechanism_.joints[eq.element].link1);
+          touch(mechanism_.joints[eq.element].link2);
+        } else {
+          touch(eq.element);
+        }
+      });
+      for (int link : links) {
+        inBall_[link] = 0;
+        for (int r : places_->attached(link)) {
+          if (position_[r] < position_[row])
+            rows.push_back(r);
+        }
+      }
+      if (rows.size() > kLocalLimit)
+        return std::nullopt;
+      std::sort(rows.begin(), rows.end(), [&](int a, int b) { return position_[a] < position_[b]; });
+      if (std::optional<SelfStress> found = eliminate(rows)) {
+        // The next row starts where this one succeeded (a regular structure needs the same radius), but a
+        // global stress must not make every later ball global.
+        spaceRadius_ = std::min(radius, 4.0 * start);
+        return found;
+      }
+      if (within == places_->numLocated())
+        return std::nullopt;  // the whole mechanism
+    }
+  }
+
   void include(int link) {
     if (inBall_[link] == 0) {
       inBall_[link] = 1;
@@ -145,11 +365,14 @@ class LocalStressFinder {
 
   /// The elimination of @p rows (the last one the row in question): its dependency, if it is dependent.
   std::optional<SelfStress> eliminate(const std::vector<int>& rows) {
+    // The columns the rows touch, by sweep priority.
     std::vector<int> columns;
-    for (int link : ball_) {
-      for (int e : model_.bodyElements[link]) {
-        for (int i = 0; i < model_.dim; ++i)
-          columns.push_back(model_.elements[e].offset + i);
+    for (int r : rows) {
+      for (SparseJacobian::InnerIterator it(J_, r); it; ++it) {
+        if (columnMap_[it.col()] < 0) {
+          columnMap_[it.col()] = 0;
+          columns.push_back(static_cast<int>(it.col()));
+        }
       }
     }
     std::sort(columns.begin(), columns.end(),
@@ -194,6 +417,9 @@ class LocalStressFinder {
   std::vector<char> inBall_, jointTaken_;
   std::vector<int> columnMap_;
   int lastRadius_ = 1;
+  std::optional<EquationPlaces> places_;  ///< Built the first time a ball in space is needed.
+  double spaceRadius_ = 0.0;
+  bool inSpaceFirst_ = false;
 };
 
 /**
@@ -237,7 +463,18 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
     if (!elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent) {
       continue;
     }
-    std::optional<SelfStress> stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
+    // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
+    // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
+    std::optional<SelfStress> stress;
+    if (finder.inSpaceFirst() && futileFinds < kFutileFinds) {
+      stress = finder.find(r);
+      if (stress)
+        ++basis.locallyResolved;
+      else
+        ++futileFinds;
+    }
+    if (!stress)
+      stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
     if (!stress && futileFinds < kFutileFinds) {
       stress = finder.find(r);
       if (stress) {
@@ -348,30 +585,36 @@ std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis&
   if (numStresses > 0) {
     // Y, one column per stress.
     std::vector<Eigen::Triplet<double>> triplets;
-    std::vector<int> leaves(numStresses, m);  // the stress's first row: where the upward sweep leaves it
+    std::vector<int> enters(numStresses, -1);  // the stress's last row: where the upward sweep meets it
     for (int s = 0; s < numStresses; ++s) {
       for (const auto& [row, value] : basis.stresses[s]) {
         triplets.emplace_back(row, s, value);
-        leaves[s] = std::min(leaves[s], row);
+        enters[s] = std::max(enters[s], row);
       }
     }
     SparseJacobian Y(m, numStresses);
     Y.setFromTriplets(triplets.begin(), triplets.end());
 
     // Rows from the last equation up, unscaled (the stresses are scaled instead, so a row of rounding noise
-    // stays noise); the stress that the sweep leaves first is the preferred pivot, so the fill stays local.
-    // Once every stress has its pivot the earlier rows are all independent and are not looked at: the
-    // rigid-link and tree-joint rows come first and the redundancy almost always lies after them.
+    // stays noise); the stress that the upward sweep met last is the preferred pivot. Once every stress has
+    // its pivot the earlier rows are all independent and are not looked at: the rigid-link and tree-joint
+    // rows come first and the redundancy almost always lies after them.
+    // Why the stress met last: measured on the 100 x 100 grid of continuous bars (19 800 local stresses),
+    // against the stress the sweep leaves first (its first row, the rule before), it took 0.72 s instead of
+    // 2.0 s and dropped residuals of 8e-12 instead of 3.5e-10 (which flagged the rank decision as near the
+    // tolerance); on every bundled mechanism and the chain, ring, bar-lattice, spatial-mast and truss-mast
+    // families the report is the same to the byte with either rule.
     EliminationOptions options;
     for (int r = m - 1; r >= 0; --r)
       options.rowOrder.push_back(r);
     options.rowScale = Eigen::VectorXd::Ones(m);
-    std::vector<int> byLeaving(numStresses);
-    std::iota(byLeaving.begin(), byLeaving.end(), 0);
-    std::stable_sort(byLeaving.begin(), byLeaving.end(), [&](int a, int b) { return leaves[a] > leaves[b]; });
+    std::vector<int> byEntering(numStresses);
+    std::iota(byEntering.begin(), byEntering.end(), 0);
+    std::stable_sort(byEntering.begin(), byEntering.end(),
+                     [&](int a, int b) { return enters[a] < enters[b]; });
     options.columnPriority.assign(numStresses, 0);
     for (int k = 0; k < numStresses; ++k)
-      options.columnPriority[byLeaving[k]] = k;
+      options.columnPriority[byEntering[k]] = k;
     options.stopAtFullRank = true;
     const OrderedRank echelon = computeSparseElimination(Y, tolerance, options);
     if (echelon.rank != numStresses)

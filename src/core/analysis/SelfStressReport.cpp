@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -24,25 +23,49 @@ bool isDistanceLike(const Joint& joint) {
   return joint.kind == ConnectionKind::Cable || joint.kind == ConnectionKind::DistanceConstraint;
 }
 
+/// One equation's share of an element's force: key (source, element), and its contribution.
+struct Share {
+  std::pair<int, int> key;
+  double value;
+};
+
+/// Sums the shares of each key, in key order; shares of one key are added in the order given (a stable sort),
+/// so the sums are the same to the last bit whatever the container.
+std::vector<Share> sumByKey(std::vector<Share>& shares) {
+  std::stable_sort(shares.begin(), shares.end(),
+                   [](const Share& a, const Share& b) { return a.key < b.key; });
+  std::vector<Share> sums;
+  for (const Share& share : shares) {
+    if (sums.empty() || sums.back().key != share.key)
+      sums.push_back(Share{share.key, 0.0});
+    sums.back().value += share.value;
+  }
+  return sums;
+}
+
 /// The elements carrying a multiplier vector given as (row, value) pairs, forces relative to the largest.
+/// (Sorted vectors, not maps: a large grid's report asks this of tens of thousands of states.)
 template <class Entries>
 std::vector<ElementForce> elementForces(const Mechanism& mechanism, const CoordinateModel& model,
                                         const Entries& entries) {
-  // key: (source, element) -> signed force (distance-like) or sum of squares.
-  std::map<std::pair<int, int>, double> signedForce, squares;
+  // (source, element) -> signed force (distance-like) or sum of squares.
+  std::vector<Share> signedShares, squareShares;
   for (const auto& [row, value] : entries) {
     const ConstraintEquation& eq = model.equations[row];
     const std::pair<int, int> key{static_cast<int>(eq.source), eq.element};
     if (eq.source == EquationSource::Joint && isDistanceLike(mechanism.joints[eq.element]) &&
         eq.kind == EquationKind::Distance) {
       // |p2 - p1|^2 = L^2 with multiplier y: axial force 2 y L, tension positive.
-      signedForce[key] += 2.0 * value * std::sqrt(std::max(eq.value, 0.0));
+      signedShares.push_back(Share{key, 2.0 * value * std::sqrt(std::max(eq.value, 0.0))});
     } else {
-      squares[key] += value * value;
+      squareShares.push_back(Share{key, value * value});
     }
   }
+  const std::vector<Share> signedForce = sumByKey(signedShares);
+  const std::vector<Share> squares = sumByKey(squareShares);
   std::vector<ElementForce> forces;
-  auto name = [&](const std::pair<int, int>& key, std::string& kind) {
+  forces.reserve(signedForce.size() + squares.size());
+  auto name = [&](const std::pair<int, int>& key, std::string& kind) -> const std::string& {
     const auto source = static_cast<EquationSource>(key.first);
     if (source == EquationSource::Joint) {
       kind = toString(mechanism.joints[key.second].kind);
@@ -51,16 +74,16 @@ std::vector<ElementForce> elementForces(const Mechanism& mechanism, const Coordi
     kind = source == EquationSource::Link ? "link" : "boundary";
     return mechanism.links[key.second].name;
   };
-  for (const auto& [key, force] : signedForce) {
+  for (const Share& share : signedForce) {
     ElementForce f;
-    f.name = name(key, f.kind);
-    f.force = force;
+    f.name = name(share.key, f.kind);
+    f.force = share.value;
     forces.push_back(f);
   }
-  for (const auto& [key, sum] : squares) {
+  for (const Share& share : squares) {
     ElementForce f;
-    f.name = name(key, f.kind);
-    f.force = std::sqrt(sum);
+    f.name = name(share.key, f.kind);
+    f.force = std::sqrt(share.value);
     forces.push_back(f);
   }
   double largest = 0.0;
@@ -68,9 +91,9 @@ std::vector<ElementForce> elementForces(const Mechanism& mechanism, const Coordi
     largest = std::max(largest, std::abs(f.force));
   // Sign of a state is free: make its largest signed (cable / distance) force a tension.
   double largestSigned = 0.0;
-  for (const auto& [key, force] : signedForce) {
-    if (std::abs(force) > std::abs(largestSigned))
-      largestSigned = force;
+  for (const Share& share : signedForce) {
+    if (std::abs(share.value) > std::abs(largestSigned))
+      largestSigned = share.value;
   }
   const double sign = largestSigned < 0.0 ? -1.0 : 1.0;
   std::vector<ElementForce> kept;
@@ -80,7 +103,7 @@ std::vector<ElementForce> elementForces(const Mechanism& mechanism, const Coordi
     const bool isSigned = f.kind == "cable" || f.kind == "distance_constraint";
     f.force = (isSigned ? sign : 1.0) * f.force / largest;
     if (std::abs(f.force) > kSupportFloor)
-      kept.push_back(f);
+      kept.push_back(std::move(f));
   }
   std::stable_sort(kept.begin(), kept.end(), [](const ElementForce& a, const ElementForce& b) {
     return std::abs(a.force) > std::abs(b.force);
