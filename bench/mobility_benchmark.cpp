@@ -24,6 +24,8 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <sys/resource.h>
@@ -108,11 +110,23 @@ int main(int argc, char** argv) {
   if (method == "full") {
     AnalysisOptions options;
     options.mode = valueOf(mode);
+    // Where the analysis goes: the seconds from each phase the analysis announces to the next (on stderr).
+    std::vector<std::pair<std::string, double>> phases;
+    options.progress = [&](const std::string& phase, double) {
+      if (phases.empty() || phases.back().first != phase) phases.emplace_back(phase, seconds());
+    };
     const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
     if (!isOk(analysis)) return fail(diagnosticOf(analysis).toString());
     const MobilityReport& report = valueOf(analysis).report;
     const double analysisSeconds = seconds() - loadSeconds;
+    const double jsonStart = seconds();
     const std::string json = toJson(report);
+    phases.emplace_back("json", jsonStart);
+    phases.emplace_back("", seconds());
+    std::fprintf(stderr, "phases: load %.3f", loadSeconds);
+    for (size_t p = 0; p + 1 < phases.size(); ++p)
+      std::fprintf(stderr, ", %s %.3f", phases[p].first.c_str(), phases[p + 1].second - phases[p].second);
+    std::fprintf(stderr, "\n");
     n = report.numCoordinates;
     m = report.numConstraints;
     dof = report.dof;
