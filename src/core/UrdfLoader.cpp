@@ -2,12 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/io/LengthRange.hpp"
 #include "mobility_analysis/io/UrdfReader.hpp"
+#include "io/XmlValues.hpp"
 
 namespace mobility_analysis {
 
@@ -29,13 +29,10 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
 }
 
 Result<Mechanism> loadMechanismFromFile(const std::string& path) {
-  std::ifstream stream(path);
-  if (!stream) {
+  std::string text;
+  if (!io_detail::readWholeFile(path, text))
     return makeDiagnostic(path, "", "", "cannot open the file");
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
-  return checked(readUrdf(text.str(), path));
+  return checked(readUrdf(text, path));
 }
 
 Result<JointPositions> makeJointPositions(const std::vector<std::string>& names,

@@ -98,12 +98,9 @@ Result<Mechanism> readMechanismFromString(const std::string& text, const std::st
 }
 
 Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& options) {
-  std::ifstream stream(path);
-  if (!stream)
+  std::string content;
+  if (!io_detail::readWholeFile(path, content))
     return makeDiagnostic(path, "", "", "cannot open the file");
-  std::stringstream text;
-  text << stream.rdbuf();
-  const std::string content = text.str();
   const std::string root = rootElement(content);
   if (root == "mujoco")
     return finish(readMjcf(path), options);
