@@ -7,7 +7,6 @@
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/io/LengthRange.hpp"
 #include "mobility_analysis/io/UrdfReader.hpp"
-#include "io/XmlValues.hpp"
 
 namespace mobility_analysis {
 
@@ -29,10 +28,7 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
 }
 
 Result<Mechanism> loadMechanismFromFile(const std::string& path) {
-  std::string text;
-  if (!io_detail::readWholeFile(path, text))
-    return makeDiagnostic(path, "", "", "cannot open the file");
-  return checked(readUrdf(text, path));
+  return checked(readUrdfFile(path));
 }
 
 Result<JointPositions> makeJointPositions(const std::vector<std::string>& names,

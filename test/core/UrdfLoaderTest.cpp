@@ -1,6 +1,8 @@
 #include "mobility_analysis/UrdfLoader.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
 #include <numeric>
 #include <random>
 
@@ -8,6 +10,8 @@
 
 #include "../../src/core/io/NameIndex.hpp"
 #include "core/TestModels.hpp"
+#include "mobility_analysis/io/ReadMechanism.hpp"
+#include "mobility_analysis/io/SdfReader.hpp"
 
 using namespace mobility_analysis;
 
@@ -308,4 +312,57 @@ TEST(NameIndex, findsEveryNameGivenThroughGrowthAndNoOther) {
   EXPECT_EQ(index.find("n", items), -1);
   EXPECT_EQ(index.find("", items), -1);
   EXPECT_EQ(index.find("n5002x", items), -1);
+}
+
+TEST(ReadMechanism, theFormatIsToldByTheRootHoweverLongTheProlog) {
+  // The root element is looked for in the file's head (64 KiB) and in the whole file when the head ends
+  // before it, or inside its name: a URDF and an SDF behind a long comment, with the name cut at every spot
+  // around the boundary, are each read by their own reader.
+  const std::string urdf =
+      "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" "
+      "type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
+      "</joint></robot>\n";
+  const std::string sdf = "<sdf version=\"1.9\"><model name=\"s\"><link name=\"a\"/></model></sdf>\n";
+  for (const size_t prolog :
+       {size_t(0), size_t(100), size_t(65536 - 20), size_t(65536 - 7), size_t(65536 - 5), size_t(65536 - 3),
+        size_t(65536 - 1), size_t(65536), size_t(200000)}) {
+    for (const bool isSdf : {false, true}) {
+      // "<?xml?>\n<!--" + padding + "-->\n" is exactly `prolog` characters (at least the markup's own).
+      const std::string start = "<?xml version=\"1.0\"?>\n<!--", end = "-->\n";
+      const size_t pad = prolog > start.size() + end.size() ? prolog - start.size() - end.size() : 0;
+      const std::string text =
+          (prolog == 0 ? "" : start + std::string(pad, 'x') + end) + (isSdf ? sdf : urdf);
+      const std::string path = ::testing::TempDir() + "prolog_" + std::to_string(prolog) + ".urdf";
+      {
+        std::ofstream out(path);
+        out << text;
+      }
+      const Result<Mechanism> read = readMechanism(path, ReadOptions{});
+      if (isSdf) {
+        // Not <robot>: the SDF reader answers, and this .urdf has no SDF model it can read as a URDF.
+        const Result<Mechanism> bySdf = readSdf(text, path);
+        ASSERT_EQ(isOk(read), isOk(bySdf)) << prolog;
+        if (!isOk(read))
+          EXPECT_EQ(diagnosticOf(read).toString(), diagnosticOf(bySdf).toString()) << prolog;
+        else
+          EXPECT_EQ(valueOf(read).name, valueOf(bySdf).name) << prolog;
+      } else {
+        ASSERT_TRUE(isOk(read)) << prolog << ": " << diagnosticOf(read).toString();
+        EXPECT_EQ(valueOf(read).name, "r");
+        EXPECT_EQ(valueOf(read).joints.size(), 1u);
+        EXPECT_EQ(valueOf(read).file, "prolog_" + std::to_string(prolog) + ".urdf");
+      }
+      std::remove(path.c_str());
+    }
+  }
+}
+
+TEST(ReadMechanism, aDirectoryOrAMissingFileCannotBeOpened) {
+  for (const std::string& path : {::testing::TempDir(), std::string("/nonexistent/x.urdf")}) {
+    for (const Result<Mechanism>& read : {readMechanism(path, ReadOptions{}), loadMechanismFromFile(path)}) {
+      ASSERT_FALSE(isOk(read)) << path;
+      EXPECT_NE(diagnosticOf(read).what.find("cannot open the file"), std::string::npos)
+          << diagnosticOf(read).toString();
+    }
+  }
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cstdio>
 #include <cstring>
 #include <initializer_list>
 
@@ -568,10 +569,12 @@ class Reader {
 
 }  // namespace
 
-Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName) {
-  const std::string file = io_detail::baseName(fileName);
-  tinyxml2::XMLDocument document;
-  if (document.Parse(urdfText.c_str(), urdfText.size()) != tinyxml2::XML_SUCCESS) {
+namespace {
+
+/// The mechanism of a parsed document (@p parsed: the parser's answer).
+Result<Mechanism> readDocument(const tinyxml2::XMLDocument& document, tinyxml2::XMLError parsed,
+                               const std::string& file) {
+  if (parsed != tinyxml2::XML_SUCCESS) {
     const char* error = document.ErrorStr();
     return makeDiagnostic(file, "xml", "", std::string("not well-formed XML: ") + (error ? error : "?"));
   }
@@ -583,6 +586,26 @@ Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileN
   } catch (const ReadFailure& failure) {
     return failure.diagnostic;
   }
+}
+
+}  // namespace
+
+Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName) {
+  tinyxml2::XMLDocument document;
+  const tinyxml2::XMLError parsed = document.Parse(urdfText.c_str(), urdfText.size());
+  return readDocument(document, parsed, io_detail::baseName(fileName));
+}
+
+Result<Mechanism> readUrdfFile(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr)
+    return makeDiagnostic(path, "", "", "cannot open the file");
+  tinyxml2::XMLDocument document;
+  const tinyxml2::XMLError parsed = document.LoadFile(file);
+  std::fclose(file);
+  if (parsed == tinyxml2::XML_ERROR_FILE_READ_ERROR || parsed == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
+    return makeDiagnostic(path, "", "", "cannot open the file");  // a directory, an unreadable file
+  return readDocument(document, parsed, io_detail::baseName(path));
 }
 
 }  // namespace mobility_analysis
