@@ -14,6 +14,8 @@
 ///          row-normalised Jacobian: the floor for any sparse rank answer (counts only); built when SuiteSparse
 ///          is found;
 /// parse:   the bare XML parse of the file (tinyxml2::XMLDocument::LoadFile), nothing else: the floor of loading;
+/// load:    loading alone: read the file, parse it and build the checked mechanism (what full spends before
+///          the analysis), with its processor seconds;
 /// slvs:    SolveSpace's solver (libslvs) on the planar bar-and-pin models it can express (SolveSpacePeer.hpp):
 ///          one Slvs_Solve, its dof; built only when libslvs is found (status=unsupported otherwise).
 /// Peak memory is the process's maximum resident set (getrusage), so run one method per process.
@@ -22,8 +24,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <sys/resource.h>
@@ -50,8 +55,15 @@ double peakMegabytes() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
+/// Processor time of this process so far [s].
+double cpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 constexpr const char* kUsage =
-    "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|slvs FILE.urdf [--mode M] [--budget S] [--orientation auto|J|JT]";
+    "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|load|slvs FILE.urdf [--mode M] [--budget S] [--orientation auto|J|JT]";
 
 int fail(const std::string& line) {
   std::cerr << line << std::endl;
@@ -79,7 +91,7 @@ int main(int argc, char** argv) {
     }
   }
   if (file.empty() || (method != "full" && method != "finite" && method != "literal" && method != "dense" &&
-                       method != "spqr" && method != "parse" && method != "slvs")) {
+                       method != "spqr" && method != "parse" && method != "load" && method != "slvs")) {
     return fail(kUsage);
   }
   const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
@@ -87,13 +99,16 @@ int main(int argc, char** argv) {
   if (method == "parse") {
     // The floor of loading: one tinyxml2 parse of the file into a DOM, as the URDF reader's first step.
     const auto parseStart = std::chrono::steady_clock::now();
+    const double parseCpuStart = cpuSeconds();
     tinyxml2::XMLDocument document;
     const tinyxml2::XMLError error = document.LoadFile(file.c_str());
     const double parseSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - parseStart).count();
     if (error != tinyxml2::XML_SUCCESS) return fail(file + ": " + document.ErrorStr());
-    std::printf("method=parse file=%s coordinates=-1 equations=-1 dof=-1 redundant=-1 seconds=%.4f peak_mb=%.1f status=ok\n",
-                file.c_str(), parseSeconds, peakMegabytes());
+    const double parseCpuSeconds = cpuSeconds() - parseCpuStart;
+    std::printf("method=parse file=%s coordinates=-1 equations=-1 dof=-1 redundant=-1 seconds=%.4f cpu_seconds=%.4f "
+                "peak_mb=%.1f status=ok\n",
+                file.c_str(), parseSeconds, parseCpuSeconds, peakMegabytes());
     return 0;
   }
   // The clock starts before the file is read: "full" is what `mobility_report --json` does, end to end.
@@ -102,17 +117,39 @@ int main(int argc, char** argv) {
   const Result<Mechanism> mechanism = loadMechanismFromFile(file);
   if (!isOk(mechanism)) return fail(diagnosticOf(mechanism).toString());
   const double loadSeconds = seconds();
+  const double loadCpuSeconds = cpuSeconds();
 
   int n = 0, m = 0, dof = -1, redundant = -1;
   std::string status = "ok";
+  if (method == "load") {
+    // Loading alone (read the file, parse it, build and check the mechanism), next to parse: the reader's cost.
+    std::printf("method=load file=%s coordinates=-1 equations=-1 dof=-1 redundant=-1 seconds=%.4f cpu_seconds=%.4f "
+                "links=%zu joints=%zu peak_mb=%.1f status=ok\n",
+                file.c_str(), loadSeconds, loadCpuSeconds, valueOf(mechanism).links.size(),
+                valueOf(mechanism).joints.size(), peakMegabytes());
+    return 0;
+  }
   if (method == "full") {
     AnalysisOptions options;
     options.mode = valueOf(mode);
+    // Where the analysis goes: the processor seconds from each phase the analysis announces to the next (on
+    // stderr; processor time, not wall clock, so that figures taken on a shared machine compare).
+    std::vector<std::pair<std::string, double>> phases;
+    options.progress = [&](const std::string& phase, double) {
+      if (phases.empty() || phases.back().first != phase) phases.emplace_back(phase, cpuSeconds());
+    };
     const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
     if (!isOk(analysis)) return fail(diagnosticOf(analysis).toString());
     const MobilityReport& report = valueOf(analysis).report;
     const double analysisSeconds = seconds() - loadSeconds;
+    const double jsonStart = cpuSeconds();
     const std::string json = toJson(report);
+    phases.emplace_back("json", jsonStart);
+    phases.emplace_back("", cpuSeconds());
+    std::fprintf(stderr, "cpu seconds: load %.3f", loadCpuSeconds);
+    for (size_t p = 0; p + 1 < phases.size(); ++p)
+      std::fprintf(stderr, ", %s %.3f", phases[p].first.c_str(), phases[p + 1].second - phases[p].second);
+    std::fprintf(stderr, "\n");
     n = report.numCoordinates;
     m = report.numConstraints;
     dof = report.dof;

@@ -103,6 +103,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
       analyzeFiniteMobility(model, analysis.assembled.q, J, basis, ranks, tolerance);
   report.finiteDof = finite.finiteDof;
   report.singular = finite.singular;
+  progress("passive freedoms", 0.87);
   // Idle groups' motions (Tsai): a rod spinning between two balls, a link sliding between parallel slides.
   const PassiveFreedoms passive = findPassiveFreedoms(mechanism, model, analysis.assembled.q, J);
   report.passiveDof = std::min(passive.dof, report.finiteDof);
@@ -131,6 +132,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
        ranks.smallestKeptPivot < tolerance * tolerances::kNearDecisionFactor) ||
       (ranks.largestDroppedResidual > tolerance / tolerances::kNearDecisionFactor);
 
+  progress("redundant equations", 0.88);
   auto elementName = [&](const ConstraintEquation& eq) {
     return eq.source == EquationSource::Joint ? mechanism.joints[eq.element].name
                                               : mechanism.links[eq.element].name;

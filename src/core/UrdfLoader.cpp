@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "mobility_analysis/Tolerances.hpp"
@@ -29,13 +28,7 @@ Result<Mechanism> loadMechanismFromString(const std::string& urdfText, const std
 }
 
 Result<Mechanism> loadMechanismFromFile(const std::string& path) {
-  std::ifstream stream(path);
-  if (!stream) {
-    return makeDiagnostic(path, "", "", "cannot open the file");
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
-  return checked(readUrdf(text.str(), path));
+  return checked(readUrdfFile(path));
 }
 
 Result<JointPositions> makeJointPositions(const std::vector<std::string>& names,

@@ -1,8 +1,17 @@
 #include "mobility_analysis/UrdfLoader.hpp"
 
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <numeric>
+#include <random>
+
 #include <gtest/gtest.h>
 
+#include "../../src/core/io/NameIndex.hpp"
 #include "core/TestModels.hpp"
+#include "mobility_analysis/io/ReadMechanism.hpp"
+#include "mobility_analysis/io/SdfReader.hpp"
 
 using namespace mobility_analysis;
 
@@ -15,10 +24,11 @@ TEST(UrdfLoader, ReadsTreeJointsLoopJointsDistanceConstraintsAndCablesInEquation
   EXPECT_EQ(m.links.size(), 8u);
   EXPECT_EQ(m.links[m.rootLink].name, "ground");
   std::vector<std::string> names;
-  for (const Joint& j : m.joints) names.push_back(j.name);
+  for (const Joint& j : m.joints)
+    names.push_back(j.name);
   // Tree joints in document order, then distance constraints, cables, loop joints (DESIGN.md §3).
-  EXPECT_EQ(names, (std::vector<std::string>{"r", "p", "fx", "pl", "fl", "cont", "fl2", "dist", "cab", "lr", "lp",
-                                             "lc", "ls", "lu", "lf"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"r", "p", "fx", "pl", "fl", "cont", "fl2", "dist", "cab", "lr",
+                                             "lp", "lc", "ls", "lu", "lf"}));
   const Joint& r = m.joints[0];
   EXPECT_EQ(r.type, JointType::Revolute);
   EXPECT_TRUE(r.axis.isApprox(Eigen::Vector3d(0, 0.6, 0.8)));
@@ -36,7 +46,8 @@ TEST(UrdfLoader, ReadsTreeJointsLoopJointsDistanceConstraintsAndCablesInEquation
   EXPECT_EQ(m.links[lr.link1].name, "d");
   EXPECT_EQ(m.links[lr.link2].name, "e");
   // rpy is URDF's fixed-axis roll-pitch-yaw.
-  EXPECT_TRUE(lr.frame2.linear().isApprox(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()).toRotationMatrix()));
+  EXPECT_TRUE(
+      lr.frame2.linear().isApprox(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()).toRotationMatrix()));
 }
 
 TEST(UrdfLoader, IsaacSimSphericalLoopJointLoadsAsItIs) {
@@ -115,4 +126,243 @@ TEST(UrdfLoader, JointPositionsAreCheckedAgainstTheMechanism) {
   EXPECT_NE(diagnosticOf(loop).what.find("loop_joint"), std::string::npos);
   EXPECT_FALSE(isOk(makeJointPositions({"j1"}, {std::nan("")}, m)));
   EXPECT_FALSE(isOk(parseJointPositions("j1=abc", m)));
+}
+
+// --- The reader's number triples and its index of names (io/UrdfReader.cpp, io/NameIndex.hpp) -------------
+
+namespace {
+
+/// A one-joint robot whose joint origin is xyz="@p xyz".
+std::string originUrdf(const std::string& xyz) {
+  return "<robot name=\"o\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" type=\"fixed\"><parent "
+         "link=\"a\"/><child link=\"b\"/><origin xyz=\"" +
+         xyz + "\"/></joint></robot>";
+}
+
+}  // namespace
+
+TEST(UrdfLoader, aNumberTripleIsThreeBlankSeparatedFiniteNumbersAndNothingElse) {
+  struct Case {
+    std::string xyz;
+    Eigen::Vector3d value;  // when fragment is empty
+    std::string fragment;   // of the diagnostic, else
+  };
+  const std::vector<Case> cases = {
+      {"1 2 3", {1, 2, 3}, ""},
+      {"\t-1.5\n2e-3   +3 ", {-1.5, 2e-3, 3}, ""},  // every blank separates, leading and trailing ones too
+      {"\r\n 0x10 0 .5\f", {16, 0, 0.5}, ""},       // strtod's forms, as before
+      {"1 2", {}, "needs 3 numbers, got 2: '1 2'"},
+      {"", {}, "needs 3 numbers, got 0"},
+      {" \t ", {}, "needs 3 numbers, got 0"},
+      {"1 2 3 4", {}, "has more than 3 numbers: '1 2 3 4'"},
+      {"1 2 x", {}, "is not a number triple ('x')"},
+      {"1 2 3x", {}, "is not a number triple ('3x')"},
+      {"1,2,3", {}, "is not a number triple ('1,2,3')"},
+      {"1 2 inf", {}, "is not finite"},
+      {"1e400 0 0", {}, "is not finite"},
+      {"0 2e12 0", {}, "outside the accepted range"},
+  };
+  for (const Case& c : cases) {
+    const Result<Mechanism> result = loadMechanismFromString(originUrdf(c.xyz), "o.urdf");
+    if (c.fragment.empty()) {
+      ASSERT_TRUE(isOk(result)) << "'" << c.xyz << "': " << diagnosticOf(result).toString();
+      EXPECT_EQ(valueOf(result).joints[0].frame1.translation(), c.value) << "'" << c.xyz << "'";
+    } else {
+      ASSERT_FALSE(isOk(result)) << "'" << c.xyz << "' was read";
+      const Diagnostic& d = diagnosticOf(result);
+      EXPECT_EQ(d.elementName, "j");
+      EXPECT_NE(d.what.find("origin xyz"), std::string::npos) << d.toString();
+      EXPECT_NE(d.what.find(c.fragment), std::string::npos) << "'" << c.xyz << "': " << d.toString();
+    }
+  }
+}
+
+TEST(UrdfLoader, namesResolveAmongThousandsWrittenInAnyOrder) {
+  // A random tree of 3000 links, links and joints each written in a shuffled order, closed by loop joints and
+  // tied by a mimic: every end must be the link of that name, every connection in equation order.
+  std::mt19937 random(13);
+  const int n = 3000;
+  std::vector<int> parent(n, -1);
+  for (int l = 1; l < n; ++l)
+    parent[l] = std::uniform_int_distribution<int>(0, l - 1)(random);
+  auto linkName = [](int l) {
+    return l == 0 ? std::string("ground") : "l" + std::to_string(l * 7919 % 100003);
+  };
+  std::vector<int> linkOrder(n), jointOrder(n - 1);
+  std::iota(linkOrder.begin(), linkOrder.end(), 0);
+  std::iota(jointOrder.begin(), jointOrder.end(), 1);
+  std::shuffle(linkOrder.begin(), linkOrder.end(), random);
+  std::shuffle(jointOrder.begin(), jointOrder.end(), random);
+  std::string text = "<robot name=\"many\">\n";
+  for (int l : linkOrder)
+    text += "<link name=\"" + linkName(l) + "\"/>\n";
+  std::vector<std::pair<int, int>> loops;
+  for (int k = 0; k < 50; ++k) {
+    const int a = std::uniform_int_distribution<int>(0, n - 1)(random);
+    const int b = std::uniform_int_distribution<int>(0, n - 1)(random);
+    if (a != b)
+      loops.emplace_back(a, b);
+  }
+  for (size_t k = 0; k < loops.size();
+       ++k) {  // loops before the tree joints in the document: order is by kind
+    text += "<loop_joint name=\"loop" + std::to_string(k) + "\" type=\"spherical\"><link1 link=\"" +
+            linkName(loops[k].first) + "\"/><link2 link=\"" + linkName(loops[k].second) +
+            "\"/></loop_joint>\n";
+  }
+  for (int l : jointOrder) {
+    text += "<joint name=\"j" + std::to_string(l) + "\" type=\"revolute\"><parent link=\"" +
+            linkName(parent[l]) + "\"/><child link=\"" + linkName(l) + "\"/><axis xyz=\"0 0 1\"/>" +
+            (l == jointOrder[0] ? "<mimic joint=\"j" + std::to_string(jointOrder[1]) + "\"/>" : "") +
+            "</joint>\n";
+  }
+  text += "</robot>\n";
+  const Result<Mechanism> result = loadMechanismFromString(text, "many.urdf");
+  ASSERT_TRUE(isOk(result)) << diagnosticOf(result).toString();
+  const Mechanism& m = valueOf(result);
+  ASSERT_EQ(m.links.size(), static_cast<size_t>(n));
+  ASSERT_EQ(m.joints.size(), static_cast<size_t>(n - 1) + loops.size() + 1);
+  for (int i = 0; i < n; ++i)
+    EXPECT_EQ(m.links[i].name, linkName(linkOrder[i]));
+  EXPECT_EQ(m.links[m.rootLink].name, "ground");
+  for (int k = 0; k < n - 1; ++k) {
+    const Joint& joint = m.joints[k];
+    const int l = jointOrder[k];
+    EXPECT_EQ(joint.name, "j" + std::to_string(l));
+    EXPECT_EQ(m.links[joint.link1].name, linkName(parent[l]));
+    EXPECT_EQ(m.links[joint.link2].name, linkName(l));
+  }
+  for (size_t k = 0; k < loops.size(); ++k) {
+    const Joint& joint = m.joints[n - 1 + k];
+    EXPECT_EQ(joint.kind, ConnectionKind::LoopJoint);
+    EXPECT_EQ(m.links[joint.link1].name, linkName(loops[k].first));
+    EXPECT_EQ(m.links[joint.link2].name, linkName(loops[k].second));
+  }
+  const Joint& mimic = m.joints.back();
+  EXPECT_EQ(mimic.kind, ConnectionKind::Coupling);
+  EXPECT_EQ(m.joints[mimic.follower].name, "j" + std::to_string(jointOrder[0]));
+  EXPECT_EQ(m.joints[mimic.leader].name, "j" + std::to_string(jointOrder[1]));
+  for (const std::string& name : {std::string("ground"), linkName(n - 1), linkName(n / 2)})
+    EXPECT_EQ(m.links[*m.findLink(name)].name, name);
+}
+
+TEST(UrdfLoader, aNameIsRefusedWhereverItWasUsedBefore) {
+  const std::string head = "<robot name=\"d\"><link name=\"a\"/><link name=\"b\"/><link name=\"c\"/>";
+  const std::string j1 =
+      "<joint name=\"j1\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
+      "<axis xyz=\"0 0 1\"/></joint>";
+  const std::string j2 =
+      "<joint name=\"j2\" type=\"revolute\"><parent link=\"b\"/><child link=\"c\"/>"
+      "<axis xyz=\"0 0 1\"/></joint>";
+  auto loop = [](const std::string& name) {
+    return "<loop_joint name=\"" + name +
+           "\" type=\"spherical\"><link1 link=\"a\"/><link2 link=\"c\"/></loop_joint>";
+  };
+  struct Case {
+    std::string body, kind, name, fragment;
+  };
+  const std::vector<Case> cases = {
+      {"<link name=\"b\"/>" + j1 + j2, "link", "b", "is defined twice"},
+      {j1 + j2 + "<joint name=\"j1\" type=\"fixed\"><parent link=\"a\"/><child link=\"c\"/></joint>", "joint",
+       "j1", "is defined twice"},
+      {j1 + j2 + loop("j2"), "loop_joint", "j2", "has the name of another joint or constraint"},
+      {j1 + j2 + loop("x") + loop("x"), "loop_joint", "x", "has the name of another joint or constraint"},
+      {j1 + j2 +
+           "<distance_constraint name=\"x\"><link1 link=\"a\"/><link2 link=\"c\"/></distance_constraint>" +
+           loop("x"),
+       "loop_joint", "x", "has the name of another joint or constraint"},
+      {j1 + j2 + loop("x") +
+           "<coupling name=\"x\"><leader joint=\"j1\"/><follower joint=\"j2\"/><ratio "
+           "value=\"1\"/></coupling>",
+       "coupling", "x", "has the name of another joint or constraint"},
+      {j1 + j2 + loop("x") +
+           "<coupling name=\"c\"><leader joint=\"x\"/><follower joint=\"j2\"/><ratio "
+           "value=\"1\"/></coupling>",
+       "coupling", "c", "predecessor 'x' is not a tree joint"},
+      {j1 + j2 +
+           "<coupling name=\"c\"><leader joint=\"j9\"/><follower joint=\"j2\"/><ratio "
+           "value=\"1\"/></coupling>",
+       "coupling", "c", "predecessor 'j9' is not a tree joint"},
+      {j1 + "<joint name=\"j2\" type=\"revolute\"><parent link=\"b\"/><child link=\"cc\"/></joint>", "joint",
+       "j2", "child 'cc' is not a link"},
+  };
+  for (const Case& c : cases) {
+    const Result<Mechanism> result = loadMechanismFromString(head + c.body + "</robot>", "d.urdf");
+    ASSERT_FALSE(isOk(result)) << c.body;
+    const Diagnostic& d = diagnosticOf(result);
+    EXPECT_EQ(d.elementKind, c.kind) << d.toString();
+    EXPECT_EQ(d.elementName, c.name) << d.toString();
+    EXPECT_NE(d.what.find(c.fragment), std::string::npos) << d.toString();
+  }
+}
+
+TEST(NameIndex, findsEveryNameGivenThroughGrowthAndNoOther) {
+  struct Named {
+    std::string name;
+  };
+  std::vector<Named> items;
+  io_detail::NameIndex index;  // no reserve: it grows from empty
+  EXPECT_EQ(index.find("x", items), -1);
+  for (int i = 0; i < 5000; ++i) {
+    items.push_back(Named{"n" + std::to_string(i * 31 % 5003)});
+    ASSERT_EQ(index.find(items.back().name, items), -1);
+    index.insert(items.back().name, i);
+  }
+  for (int i = 0; i < 5000; ++i)
+    EXPECT_EQ(index.find(items[i].name, items), i);
+  EXPECT_EQ(index.find("n", items), -1);
+  EXPECT_EQ(index.find("", items), -1);
+  EXPECT_EQ(index.find("n5002x", items), -1);
+}
+
+TEST(ReadMechanism, theFormatIsToldByTheRootHoweverLongTheProlog) {
+  // The root element is looked for in the file's head (64 KiB) and in the whole file when the head ends
+  // before it, or inside its name: a URDF and an SDF behind a long comment, with the name cut at every spot
+  // around the boundary, are each read by their own reader.
+  const std::string urdf =
+      "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" "
+      "type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/><axis xyz=\"0 0 1\"/>"
+      "</joint></robot>\n";
+  const std::string sdf = "<sdf version=\"1.9\"><model name=\"s\"><link name=\"a\"/></model></sdf>\n";
+  for (const size_t prolog :
+       {size_t(0), size_t(100), size_t(65536 - 20), size_t(65536 - 7), size_t(65536 - 5), size_t(65536 - 3),
+        size_t(65536 - 1), size_t(65536), size_t(200000)}) {
+    for (const bool isSdf : {false, true}) {
+      // "<?xml?>\n<!--" + padding + "-->\n" is exactly `prolog` characters (at least the markup's own).
+      const std::string start = "<?xml version=\"1.0\"?>\n<!--", end = "-->\n";
+      const size_t pad = prolog > start.size() + end.size() ? prolog - start.size() - end.size() : 0;
+      const std::string text =
+          (prolog == 0 ? "" : start + std::string(pad, 'x') + end) + (isSdf ? sdf : urdf);
+      const std::string path = ::testing::TempDir() + "prolog_" + std::to_string(prolog) + ".urdf";
+      {
+        std::ofstream out(path);
+        out << text;
+      }
+      const Result<Mechanism> read = readMechanism(path, ReadOptions{});
+      if (isSdf) {
+        // Not <robot>: the SDF reader answers, and this .urdf has no SDF model it can read as a URDF.
+        const Result<Mechanism> bySdf = readSdf(text, path);
+        ASSERT_EQ(isOk(read), isOk(bySdf)) << prolog;
+        if (!isOk(read))
+          EXPECT_EQ(diagnosticOf(read).toString(), diagnosticOf(bySdf).toString()) << prolog;
+        else
+          EXPECT_EQ(valueOf(read).name, valueOf(bySdf).name) << prolog;
+      } else {
+        ASSERT_TRUE(isOk(read)) << prolog << ": " << diagnosticOf(read).toString();
+        EXPECT_EQ(valueOf(read).name, "r");
+        EXPECT_EQ(valueOf(read).joints.size(), 1u);
+        EXPECT_EQ(valueOf(read).file, "prolog_" + std::to_string(prolog) + ".urdf");
+      }
+      std::remove(path.c_str());
+    }
+  }
+}
+
+TEST(ReadMechanism, aDirectoryOrAMissingFileCannotBeOpened) {
+  for (const std::string& path : {::testing::TempDir(), std::string("/nonexistent/x.urdf")}) {
+    for (const Result<Mechanism>& read : {readMechanism(path, ReadOptions{}), loadMechanismFromFile(path)}) {
+      ASSERT_FALSE(isOk(read)) << path;
+      EXPECT_NE(diagnosticOf(read).what.find("cannot open the file"), std::string::npos)
+          << diagnosticOf(read).toString();
+    }
+  }
 }

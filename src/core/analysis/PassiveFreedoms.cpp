@@ -39,6 +39,22 @@ Eigen::Isometry3d exponential(const Eigen::Vector3d& omega, const Eigen::Vector3
   return g;
 }
 
+/// One row of T: the velocity of one coordinate per twist component (lambda of the 6 used, the rest zero).
+using TwistRow = Eigen::Matrix<double, 1, 6>;
+
+/// @return Whether sigma_min(A) > @p bound is certain from G = A^T A (its top-left L x L block):
+/// sigma_min(A)^2
+///         is at least 1 / |G^-1|_F.
+template <int L>
+bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
+  const Eigen::Matrix<double, L, L> g = gram.template topLeftCorner<L, L>();
+  const Eigen::LLT<Eigen::Matrix<double, L, L>> llt(g);
+  if (llt.info() != Eigen::Success)
+    return false;
+  const double inverseNorm = llt.solve(Eigen::Matrix<double, L, L>::Identity()).norm();
+  return std::isfinite(inverseNorm) && inverseNorm > 0.0 && std::sqrt(1.0 / inverseNorm) > bound;
+}
+
 }  // namespace
 
 PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const CoordinateModel& model,
@@ -106,6 +122,10 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
   groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
 
   const Eigen::SparseMatrix<double> Jc = J;  // column access
+  // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
+  std::vector<double> rowNorm(static_cast<size_t>(J.rows()));
+  for (Eigen::Index r = 0; r < J.rows(); ++r)
+    rowNorm[static_cast<size_t>(r)] = J.row(r).norm();
   auto element3 = [&](int e) {
     const int o = model.elements[e].offset;
     return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
@@ -118,7 +138,9 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
   std::vector<char> inGroup(numLinks, 0);
   std::vector<int> localColumn(model.numCoordinates(), -1);
   Eigen::VectorXd moved = q;
-  std::vector<int> group;
+  // Work space of one group, reused (a chain of 10^5 links has 3 10^5 groups: no allocation per group).
+  std::vector<int> group, outside, elements, columns, rows;
+  std::vector<TwistRow> twistRows;  // the rows of T below (lambda entries, zero beyond)
   for (const Group& padded : groups) {
     group.assign(padded.begin(), std::find(padded.begin(), padded.end(), -1));
     for (int l : group)
@@ -134,7 +156,7 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     // T: coordinates of the group's elements per twist component (space: omega, v; plane: omega_z, v_x, v_y).
     // Its end connections must reach at least two other links: a link turning on connections to one link
     // only (a door on its hinges, a robot's last link) is that link's output, not an idle motion.
-    std::vector<int> outside;
+    outside.clear();
     for (int l : group) {
       for (int j : connectionsAt[l]) {
         const Joint& joint = mechanism.joints[j];
@@ -153,11 +175,11 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     }
     if (outside.size() < 2 || ends != 2)
       continue;
-    std::vector<int> elements;
+    elements.clear();
     for (int l : group)
       elements.insert(elements.end(), model.bodyElements[l].begin(), model.bodyElements[l].end());
-    std::vector<int> columns;
-    Eigen::MatrixXd T(static_cast<Eigen::Index>(elements.size()) * dim, lambda);
+    columns.clear();
+    twistRows.clear();
     for (size_t i = 0; i < elements.size(); ++i) {
       const Eigen::Vector3d x = element3(elements[i]);
       const bool isPoint = model.elements[elements[i]].isPoint;
@@ -167,14 +189,16 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
           isPoint ? Eigen::Matrix3d(Eigen::Matrix3d::Identity()) : Eigen::Matrix3d(Eigen::Matrix3d::Zero());
       for (int k = 0; k < dim; ++k) {
         columns.push_back(model.elements[elements[i]].offset + k);
+        TwistRow t = TwistRow::Zero();
         if (planar)
-          T.row(static_cast<Eigen::Index>(i) * dim + k) << block(k, 2), block(k, 3), block(k, 4);
+          t.head<3>() << block(k, 2), block(k, 3), block(k, 4);
         else
-          T.row(static_cast<Eigen::Index>(i) * dim + k) = block.row(k);
+          t = block.row(k);
+        twistRows.push_back(t);
       }
     }
     // A = J(rows touching the group, group columns) T, rows scaled to unit norm.
-    std::vector<int> rows;
+    rows.clear();
     for (int c : columns) {
       for (Eigen::SparseMatrix<double>::InnerIterator it(Jc, c); it; ++it)
         rows.push_back(static_cast<int>(it.row()));
@@ -183,9 +207,39 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
     for (size_t c = 0; c < columns.size(); ++c)
       localColumn[columns[c]] = static_cast<int>(c);
+    // Most groups (every link of a serial chain) have no null twist at all. sigma_min(A)^2 is at least
+    // 1 / |(A^T A)^-1|_F and sigma_max(A) at most |A|_F: when these bounds clear the nullity test a
+    // hundredfold (far beyond what rounding in A^T A can move them), no twist can pass it and the SVD is
+    // skipped; otherwise it decides exactly as before. A^T A is summed row by row in fixed-size storage (at
+    // most 6 x 6), A itself is built only for the SVD.
+    if (static_cast<int>(rows.size()) >= lambda) {
+      Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+      double frobenius2 = 0.0;
+      TwistRow a;
+      for (int r : rows) {
+        a.setZero();
+        const double norm = rowNorm[static_cast<size_t>(r)];
+        for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
+          const int c = localColumn[it.col()];
+          if (c >= 0)
+            a += (it.value() / norm) * twistRows[static_cast<size_t>(c)];
+        }
+        gram.noalias() += a.transpose() * a;
+        frobenius2 += a.squaredNorm();
+      }
+      const double bound = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
+      if (planar ? clearlyFullRank<3>(gram, bound) : clearlyFullRank<6>(gram, bound)) {
+        for (int c : columns)
+          localColumn[c] = -1;
+        continue;
+      }
+    }
+    Eigen::MatrixXd T(static_cast<Eigen::Index>(twistRows.size()), lambda);
+    for (size_t c = 0; c < twistRows.size(); ++c)
+      T.row(static_cast<Eigen::Index>(c)) = twistRows[c].head(lambda);
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), lambda);
     for (size_t r = 0; r < rows.size(); ++r) {
-      const double norm = J.row(rows[r]).norm();
+      const double norm = rowNorm[static_cast<size_t>(rows[r])];
       for (SparseJacobian::InnerIterator it(J, rows[r]); it; ++it) {
         const int c = localColumn[it.col()];
         if (c >= 0)
@@ -194,20 +248,6 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     }
     for (int c : columns)
       localColumn[c] = -1;
-    // Most groups (every link of a serial chain) have no null twist at all. sigma_min(A)^2 is at least
-    // 1 / |(A^T A)^-1|_F and sigma_max(A) at most |A|_F: when these bounds clear the nullity test a
-    // hundredfold (far beyond what rounding in A^T A can move them), no twist can pass it and the SVD is
-    // skipped; otherwise it decides exactly as before.
-    if (A.rows() >= lambda) {
-      const Eigen::MatrixXd gram = A.transpose() * A;
-      const Eigen::LLT<Eigen::MatrixXd> llt(gram);
-      if (llt.info() == Eigen::Success) {
-        const double inverseNorm = llt.solve(Eigen::MatrixXd::Identity(lambda, lambda)).norm();
-        if (std::isfinite(inverseNorm) && inverseNorm > 0.0 &&
-            std::sqrt(1.0 / inverseNorm) > 100.0 * kTwistNullity * std::max(A.norm(), 1.0))
-          continue;
-      }
-    }
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
     const Eigen::VectorXd sigma = svd.singularValues();
     const double largest = sigma.size() > 0 ? sigma(0) : 0.0;

@@ -10,6 +10,8 @@ void orderCoordinates(ModelBuilder& builder) {
   std::vector<Element> ordered;
   std::vector<int> newIndex(model.elements.size());
   std::vector<Eigen::Vector3d> orderedWorld;
+  ordered.reserve(model.elements.size());
+  orderedWorld.reserve(model.elements.size());
   for (size_t b = 0; b < builder.mechanism.links.size(); ++b) {
     for (int e : model.bodyElements[b]) {
       newIndex[e] = static_cast<int>(ordered.size());

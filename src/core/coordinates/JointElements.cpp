@@ -37,6 +37,10 @@ std::optional<Diagnostic> addJointElements(ModelBuilder& builder) {
   CoordinateModel& model = builder.model;
   const double lc = model.characteristicLength;
   builder.connections.assign(mechanism.joints.size(), ConnectionElements{});
+  // At most four elements a connection and three a body (bases): reserved, not regrown.
+  const size_t elements = 4 * mechanism.joints.size() + 3 * mechanism.links.size();
+  model.elements.reserve(elements);
+  builder.world.reserve(elements);
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     const Joint& joint = mechanism.joints[j];
     ConnectionElements& c = builder.connections[j];

@@ -1,3 +1,5 @@
+#include <algorithm>
+
 #include <Eigen/Dense>
 
 #include "mobility_analysis/coordinates/ModelBuilder.hpp"
@@ -10,6 +12,16 @@ void addRigidLinkEquations(ModelBuilder& builder) {
   const int dim = model.dim;
   // Links in document order: the basis dot products (d_i.d_j fixed), then every other element as a linear
   // combination of the basis (García de Jalón & Bayo, ch. 3), so each body keeps exactly lambda freedoms.
+  // Room for every equation of the model at once (these, then the joints' and the ground's, about lambda - F
+  // each): 10^6 equations are not copied over and over while the vector grows.
+  size_t count = 0;
+  for (size_t b = 0; b < builder.mechanism.links.size(); ++b)
+    count += (planar ? 1 : 3) + static_cast<size_t>(dim) * model.bodyElements[b].size();
+  for (size_t j = 0; j < builder.mechanism.joints.size(); ++j) {
+    if (model.jointActive[j] && model.jointFreedom[j] >= 0)
+      count += static_cast<size_t>(std::max(model.lambda - model.jointFreedom[j], 0));
+  }
+  model.equations.reserve(model.equations.size() + count + static_cast<size_t>(2 * model.lambda));
   for (size_t b = 0; b < builder.mechanism.links.size(); ++b) {
     const BodyBasis& basis = builder.bases[b];
     std::vector<Direction> dirs = {basis.d1};

@@ -17,7 +17,10 @@ namespace mobility_analysis {
 namespace {
 
 /// The name of the document's root element, after the XML declaration, comments and doctype; "" if none.
-std::string rootElement(const std::string& text) {
+/// @p complete (if given): the text goes on after the name (false: it may have been cut short, or be absent).
+std::string rootElement(const std::string& text, bool* complete = nullptr) {
+  if (complete != nullptr)
+    *complete = false;
   size_t at = 0;
   while (true) {
     at = text.find('<', at);
@@ -36,8 +39,27 @@ std::string rootElement(const std::string& text) {
     while (end < text.size() && text[end] != ' ' && text[end] != '>' && text[end] != '/' &&
            text[end] != '\n' && text[end] != '\t' && text[end] != '\r')
       ++end;
+    if (complete != nullptr)
+      *complete = end < text.size();
     return text.substr(at + 1, end - at - 1);
   }
+}
+
+/// How much of a file is read to find its root element [bytes].
+constexpr size_t kHeadBytes = 1 << 16;
+
+/// The first @p maxBytes of the file at @p path in @p head; @p whole: that is all of it.
+bool readFileHead(const std::string& path, size_t maxBytes, std::string& head, bool& whole) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr)
+    return false;
+  head.resize(maxBytes);
+  const size_t got = std::fread(&head[0], 1, maxBytes, file);
+  const bool ok = std::ferror(file) == 0;
+  std::fclose(file);
+  head.resize(got);
+  whole = got < maxBytes;
+  return ok;
 }
 
 Result<Mechanism> finish(Result<Mechanism> mechanism, const ReadOptions& options) {
@@ -98,19 +120,29 @@ Result<Mechanism> readMechanismFromString(const std::string& text, const std::st
 }
 
 Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& options) {
-  std::ifstream stream(path);
-  if (!stream)
+  // The root element from the file's head; the whole text is read only for the reader that takes text (SDF):
+  // the URDF reader and MuJoCo read the file themselves, so a large URDF is in memory once.
+  std::string head;
+  bool whole = false;
+  if (!readFileHead(path, kHeadBytes, head, whole))
     return makeDiagnostic(path, "", "", "cannot open the file");
-  std::stringstream text;
-  text << stream.rdbuf();
-  const std::string content = text.str();
-  const std::string root = rootElement(content);
+  bool complete = false;
+  std::string root = rootElement(head, &complete);
+  if (!whole && !complete) {  // the head ends inside the prolog or the root's name
+    if (!io_detail::readWholeFile(path, head))
+      return makeDiagnostic(path, "", "", "cannot open the file");
+    whole = true;
+    root = rootElement(head);
+  }
   if (root == "mujoco")
     return finish(readMjcf(path), options);
   const bool sdfExtension = path.size() >= 4 && path.compare(path.size() - 4, 4, ".sdf") == 0;
-  if (root == "sdf" || (sdfExtension && root != "robot"))
-    return finish(readSdf(content, path), options);
-  return finish(readUrdf(content, path), options);
+  if (root == "sdf" || (sdfExtension && root != "robot")) {
+    if (!whole && !io_detail::readWholeFile(path, head))
+      return makeDiagnostic(path, "", "", "cannot open the file");
+    return finish(readSdf(head, path), options);
+  }
+  return finish(readUrdfFile(path), options);
 }
 
 }  // namespace mobility_analysis

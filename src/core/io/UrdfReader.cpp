@@ -1,14 +1,15 @@
 #include "mobility_analysis/io/UrdfReader.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <cstdio>
+#include <cstring>
 #include <initializer_list>
-#include <set>
-#include <unordered_map>
-#include <unordered_set>
 
 #include <tinyxml2.h>
 
+#include "NameIndex.hpp"
 #include "XmlValues.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
@@ -27,12 +28,36 @@ struct ReadFailure {
 };
 
 /// Top-level elements that carry nothing for mobility and are well known: skipped without a warning.
-const std::set<std::string> kIgnoredElements = {"gazebo",   "transmission", "ros2_control",
-                                                "material", "sensor",       "drake:collision_filter_group"};
+constexpr std::array<const char*, 6> kIgnoredElements = {
+    "gazebo", "transmission", "ros2_control", "material", "sensor", "drake:collision_filter_group"};
 
-/// Top-level elements this reader understands.
-const std::set<std::string> kReadElements = {"link",  "joint", "loop_joint", "distance_constraint",
-                                             "cable", "loop",  "coupling"};
+/// Top-level elements this reader understands, in the order of their kinds (TopLevel).
+constexpr std::array<const char*, 7> kReadElements = {
+    "link", "joint", "distance_constraint", "cable", "loop_joint", "loop", "coupling"};
+
+/// What a top-level element is: its index in kReadElements, kIgnored or kUnknown.
+enum TopLevel : int { kLink, kJoint, kDistance, kCable, kLoopJoint, kLoop, kCoupling, kIgnored, kUnknown };
+
+TopLevel classify(const char* tag) {
+  for (size_t i = 0; i < kReadElements.size(); ++i) {
+    if (std::strcmp(tag, kReadElements[i]) == 0)
+      return static_cast<TopLevel>(i);
+  }
+  for (const char* ignored : kIgnoredElements) {
+    if (std::strcmp(tag, ignored) == 0)
+      return kIgnored;
+  }
+  return kUnknown;
+}
+
+/// kReadElements in alphabetical order: the order the "did you mean" hints are given in.
+constexpr std::array<const char*, 7> kKnownSorted = {"cable", "coupling", "distance_constraint", "joint",
+                                                     "link",  "loop",     "loop_joint"};
+
+/// Blanks as `std::istream >> std::string` splits on them (the "C" locale's isspace).
+bool isBlank(char c) {
+  return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r';
+}
 
 /// @return @p name lower-cased without '_', '-' and ':', so a misspelt `<loopjoint>` can be pointed at.
 std::string squashed(const std::string& name) {
@@ -95,27 +120,44 @@ class Reader {
   Mechanism read(const tinyxml2::XMLElement* robot) {
     const char* robotName = robot->Attribute("name");
     mechanism_.name = robotName == nullptr ? "" : robotName;
-    checkTopLevelElements(robot);
-    readLinks(robot);
-    readTreeJoints(robot);
+    // One walk over the top-level elements sorts them by kind (document order within each kind) and warns
+    // about the unknown ones; each kind is then read in the equation order of DESIGN.md §3.
+    std::array<std::vector<const tinyxml2::XMLElement*>, kIgnored> byKind;
+    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
+      const TopLevel kind = classify(e->Name());
+      if (kind == kUnknown)
+        warnUnknown(e);
+      else if (kind != kIgnored)
+        byKind[kind].push_back(e);
+    }
+    mechanism_.links.reserve(byKind[kLink].size());
+    linkIndex_.reserve(byKind[kLink].size());
+    size_t connections = 0;
+    for (int kind = kJoint; kind < kIgnored; ++kind)
+      connections += byKind[kind].size();
+    mechanism_.joints.reserve(connections);
+    connectionIndex_.reserve(connections);
+    readLinks(byKind[kLink]);
+    readTreeJoints(byKind[kJoint]);
     checkTree();
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
-      if (std::string(e->Name()) == "distance_constraint")
-        readTwoEnded(e, ConnectionKind::DistanceConstraint);
+    for (const tinyxml2::XMLElement* e : byKind[kDistance])
+      readTwoEnded(e, ConnectionKind::DistanceConstraint);
+    for (const tinyxml2::XMLElement* e : byKind[kCable])
+      readTwoEnded(e, ConnectionKind::Cable);
+    // <loop_joint> and <loop> in document order, mixed.
+    std::vector<const tinyxml2::XMLElement*>& loops = byKind[kLoopJoint];
+    if (!byKind[kLoop].empty()) {
+      loops.clear();
+      for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
+        const TopLevel kind = classify(e->Name());
+        if (kind == kLoopJoint || kind == kLoop)
+          loops.push_back(e);
+      }
     }
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
-      if (std::string(e->Name()) == "cable")
-        readTwoEnded(e, ConnectionKind::Cable);
-    }
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
-      const std::string tag = e->Name();
-      if (tag == "loop_joint" || tag == "loop")
-        readLoop(e);
-    }
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement("coupling"); e;
-         e = e->NextSiblingElement("coupling")) {
+    for (const tinyxml2::XMLElement* e : loops)
+      readLoop(e);
+    for (const tinyxml2::XMLElement* e : byKind[kCoupling])
       readCoupling(e);
-    }
     for (const PendingCoupling& coupling : couplings_)
       addCoupling(coupling);
     return std::move(mechanism_);
@@ -147,19 +189,30 @@ class Reader {
                          const std::string& attribute) const {
     if (text == nullptr)
       return Eigen::Vector3d::Zero();
-    std::istringstream stream(text);
     Eigen::Vector3d v;
-    std::string token;
     int count = 0;
-    while (stream >> token) {
+    const char* at = text;
+    while (true) {
+      while (isBlank(*at))
+        ++at;
+      if (*at == '\0')
+        break;
+      const char* tokenEnd = at;
+      while (*tokenEnd != '\0' && !isBlank(*tokenEnd))
+        ++tokenEnd;
       if (count == 3)
         fail(kind, name, attribute + " has more than 3 numbers: '" + text + "'");
-      const std::optional<double> value = parseDouble(token);
-      if (!value)
-        fail(kind, name, attribute + " '" + text + "' is not a number triple ('" + token + "')");
-      if (const std::optional<std::string> why = checkRange(*value))
+      // A number is the whole token (strtod never reads a blank, so it cannot run past the token).
+      char* end = nullptr;
+      const double value = std::strtod(at, &end);
+      if (end != tokenEnd) {
+        fail(kind, name,
+             attribute + " '" + text + "' is not a number triple ('" + std::string(at, tokenEnd) + "')");
+      }
+      if (const std::optional<std::string> why = checkRange(value))
         fail(kind, name, attribute + " '" + text + "' " + *why);
-      v[count++] = *value;
+      v[count++] = value;
+      at = tokenEnd;
     }
     if (count != 3)
       fail(kind, name, attribute + " needs 3 numbers, got " + std::to_string(count) + ": '" + text + "'");
@@ -200,68 +253,75 @@ class Reader {
            const std::string& role) const {
     if (name == nullptr)
       fail(kind, element, "<" + role + "> has no link attribute");
-    const auto it = links_.find(name);
-    if (it == links_.end())
+    const int index = linkIndex_.find(name, mechanism_.links);
+    if (index < 0)
       fail(kind, element, role + " '" + name + "' is not a link");
-    return it->second;
+    return index;
   }
 
   /// Warns about every child of a loop element that is not in @p known, and about a repeated known child.
   void checkChildren(const tinyxml2::XMLElement* e, const std::string& kind, const std::string& name,
-                     const std::set<std::string>& known) {
-    std::set<std::string> seen;
+                     std::initializer_list<const char*> known) {
+    unsigned seen = 0;  // bit i: known[i] met
     for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
-      const std::string tag = c->Name();
-      if (known.count(tag) == 0) {
-        warn(kind, name, "unknown child <" + tag + "> is not read");
-      } else if (!seen.insert(tag).second) {
-        warn(kind, name, "has more than one <" + tag + ">; the first is read");
+      const char* tag = c->Name();
+      unsigned bit = 0;
+      for (size_t i = 0; i < known.size(); ++i) {
+        if (std::strcmp(tag, known.begin()[i]) == 0)
+          bit = 1u << i;
       }
+      if (bit == 0) {
+        warn(kind, name, "unknown child <" + std::string(tag) + "> is not read");
+      } else if ((seen & bit) != 0) {
+        warn(kind, name, "has more than one <" + std::string(tag) + ">; the first is read");
+      }
+      seen |= bit;
     }
   }
 
-  void checkTopLevelElements(const tinyxml2::XMLElement* robot) {
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
-      const std::string tag = e->Name();
-      if (kReadElements.count(tag) != 0 || kIgnoredElements.count(tag) != 0)
-        continue;
-      const char* name = e->Attribute("name");
-      std::string what = "unknown element <" + tag + "> is not read";
-      for (const std::string& known : kReadElements) {
-        if (squashed(known) == squashed(tag))
-          what += " (did you mean <" + known + ">?)";
-      }
-      if (tag == "loop_constraint")
-        what += " (the URDF+ form <loop> with <predecessor>/<successor> is read)";
-      warn(tag, name == nullptr ? "" : name, what);
+  void warnUnknown(const tinyxml2::XMLElement* e) {
+    const std::string tag = e->Name();
+    const char* name = e->Attribute("name");
+    std::string what = "unknown element <" + tag + "> is not read";
+    for (const std::string known : kKnownSorted) {
+      if (squashed(known) == squashed(tag))
+        what += " (did you mean <" + known + ">?)";
     }
+    if (tag == "loop_constraint")
+      what += " (the URDF+ form <loop> with <predecessor>/<successor> is read)";
+    warn(tag, name == nullptr ? "" : name, what);
   }
 
-  void readLinks(const tinyxml2::XMLElement* robot) {
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement("link"); e;
-         e = e->NextSiblingElement("link")) {
+  void readLinks(const std::vector<const tinyxml2::XMLElement*>& elements) {
+    for (const tinyxml2::XMLElement* e : elements) {
       const char* name = e->Attribute("name");
       if (name == nullptr || *name == '\0')
         fail("link", "", "has no name");
-      if (!links_.emplace(name, static_cast<int>(mechanism_.links.size())).second)
+      if (linkIndex_.find(name, mechanism_.links) >= 0)
         fail("link", name, "is defined twice");
-      mechanism_.links.push_back(Link{name});
+      linkIndex_.insert(name, static_cast<int>(mechanism_.links.size()));
+      mechanism_.links.push_back(Link{std::string(name)});
     }
     if (mechanism_.links.empty())
       fail("robot", mechanism_.name, "has no <link>");
   }
 
-  void claimName(const std::string& kind, const std::string& name) {
-    if (!names_.insert(name).second) {
+  /// Refuses @p name when a connection has it already (the connection itself is added by addConnection).
+  void claimName(const std::string& kind, const std::string& name) const {
+    if (connectionIndex_.find(name, mechanism_.joints) >= 0)
       fail(kind, name, kind == "joint" ? "is defined twice" : "has the name of another joint or constraint");
-    }
   }
 
-  void readTreeJoints(const tinyxml2::XMLElement* robot) {
+  /// Appends @p joint to the mechanism's connections, and its name to their index.
+  void addConnection(Joint&& joint) {
+    connectionIndex_.insert(joint.name, static_cast<int>(mechanism_.joints.size()));
+    mechanism_.joints.push_back(std::move(joint));
+  }
+
+  void readTreeJoints(const std::vector<const tinyxml2::XMLElement*>& elements) {
     parentOf_.assign(mechanism_.links.size(), -1);
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement("joint"); e;
-         e = e->NextSiblingElement("joint")) {
-      const std::string name = elementName(e, "joint");
+    for (const tinyxml2::XMLElement* e : elements) {
+      std::string name = elementName(e, "joint");
       claimName("joint", name);
       const tinyxml2::XMLElement* parent = e->FirstChildElement("parent");
       const tinyxml2::XMLElement* child = e->FirstChildElement("child");
@@ -286,7 +346,6 @@ class Reader {
                  "' is not a URDF tree type (revolute, continuous, prismatic, fixed, floating, planar)");
       }
       Joint joint;
-      joint.name = name;
       joint.kind = ConnectionKind::TreeJoint;
       joint.type = *jointType;
       joint.link1 = parentLink;
@@ -318,11 +377,11 @@ class Reader {
           coupling.multiplier = number(mimic->Attribute("multiplier"), "joint", name, "mimic multiplier");
         if (mimic->Attribute("offset"))
           coupling.offset = number(mimic->Attribute("offset"), "joint", name, "mimic offset");
-        couplings_.push_back(coupling);
+        couplings_.push_back(std::move(coupling));
       }
       parentOf_[childLink] = parentLink;
-      jointIndex_.emplace(name, static_cast<int>(mechanism_.joints.size()));
-      mechanism_.joints.push_back(joint);
+      joint.name = std::move(name);
+      addConnection(std::move(joint));
     }
   }
 
@@ -403,7 +462,7 @@ class Reader {
         fail("cable", joint.name, "length must be positive, got " + std::string(e->Attribute("length")));
     }
     readEnds(e, "link1", "link2", kindName, joint);
-    mechanism_.joints.push_back(joint);
+    addConnection(std::move(joint));
   }
 
   /// <loop_joint> of our dialect (Isaac Sim, Drake) or URDF+ <loop>: the same connection, two spellings.
@@ -438,7 +497,7 @@ class Reader {
     joint.axis2 = axis(e, "axis2", kind, joint.name, Eigen::Vector3d::UnitY());
     if (joint.type == JointType::Universal && joint.axis.cross(joint.axis2).norm() < tolerances::kPlanarAxis)
       fail(kind, joint.name, "universal joint axes 'axis' and 'axis2' are parallel");
-    mechanism_.joints.push_back(joint);
+    addConnection(std::move(joint));
   }
 
   /// URDF+ <coupling>: successor = ratio * predecessor + offset.
@@ -468,21 +527,21 @@ class Reader {
     coupling.multiplier = number(ratio->Attribute("value"), "coupling", coupling.name, "ratio value");
     if (const tinyxml2::XMLElement* offset = e->FirstChildElement("offset"))
       coupling.offset = number(offset->Attribute("value"), "coupling", coupling.name, "offset value");
-    couplings_.push_back(coupling);
+    couplings_.push_back(std::move(coupling));
   }
 
   void addCoupling(const PendingCoupling& pending) {
     const std::string& element = pending.kind == "joint" ? pending.follower : pending.name;
     auto resolve = [&](const std::string& jointName, const char* role) {
-      const auto it = jointIndex_.find(jointName);
-      if (it == jointIndex_.end())
+      const int found = connectionIndex_.find(jointName, mechanism_.joints);
+      if (found < 0 || mechanism_.joints[found].kind != ConnectionKind::TreeJoint)
         fail(pending.kind, element, std::string(role) + " '" + jointName + "' is not a tree joint");
-      if (!isOneFreedom(mechanism_.joints[it->second])) {
+      if (!isOneFreedom(mechanism_.joints[found])) {
         fail(pending.kind, element,
-             std::string(role) + " '" + jointName + "' is " + toString(mechanism_.joints[it->second].type) +
+             std::string(role) + " '" + jointName + "' is " + toString(mechanism_.joints[found].type) +
                  "; only revolute, continuous and prismatic joints can be coupled");
       }
-      return it->second;
+      return found;
     };
     Joint joint;
     joint.name = pending.name;
@@ -497,24 +556,25 @@ class Reader {
     joint.link2 = mechanism_.joints[joint.leader].link2;
     joint.multiplier = pending.multiplier;
     joint.offset = pending.offset;
-    mechanism_.joints.push_back(joint);
+    addConnection(std::move(joint));
   }
 
   std::string file_;
   Mechanism mechanism_;
-  std::unordered_map<std::string, int> links_;       ///< Link index by name (10^5 links: hashed).
-  std::unordered_map<std::string, int> jointIndex_;  ///< Tree joint index by name.
-  std::unordered_set<std::string> names_;            ///< Every connection name so far.
+  io_detail::NameIndex linkIndex_;        ///< Link index by name.
+  io_detail::NameIndex connectionIndex_;  ///< Connection index (into mechanism_.joints) by name.
   std::vector<int> parentOf_;
   std::vector<PendingCoupling> couplings_;
 };
 
 }  // namespace
 
-Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName) {
-  const std::string file = io_detail::baseName(fileName);
-  tinyxml2::XMLDocument document;
-  if (document.Parse(urdfText.c_str(), urdfText.size()) != tinyxml2::XML_SUCCESS) {
+namespace {
+
+/// The mechanism of a parsed document (@p parsed: the parser's answer).
+Result<Mechanism> readDocument(const tinyxml2::XMLDocument& document, tinyxml2::XMLError parsed,
+                               const std::string& file) {
+  if (parsed != tinyxml2::XML_SUCCESS) {
     const char* error = document.ErrorStr();
     return makeDiagnostic(file, "xml", "", std::string("not well-formed XML: ") + (error ? error : "?"));
   }
@@ -526,6 +586,26 @@ Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileN
   } catch (const ReadFailure& failure) {
     return failure.diagnostic;
   }
+}
+
+}  // namespace
+
+Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName) {
+  tinyxml2::XMLDocument document;
+  const tinyxml2::XMLError parsed = document.Parse(urdfText.c_str(), urdfText.size());
+  return readDocument(document, parsed, io_detail::baseName(fileName));
+}
+
+Result<Mechanism> readUrdfFile(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr)
+    return makeDiagnostic(path, "", "", "cannot open the file");
+  tinyxml2::XMLDocument document;
+  const tinyxml2::XMLError parsed = document.LoadFile(file);
+  std::fclose(file);
+  if (parsed == tinyxml2::XML_ERROR_FILE_READ_ERROR || parsed == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
+    return makeDiagnostic(path, "", "", "cannot open the file");  // a directory, an unreadable file
+  return readDocument(document, parsed, io_detail::baseName(path));
 }
 
 }  // namespace mobility_analysis

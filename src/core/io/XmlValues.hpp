@@ -3,6 +3,7 @@
 // Private to the readers in src/core/io: strict number parsing shared by the XML readers.
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <sstream>
@@ -73,6 +74,32 @@ inline Eigen::Isometry3d makeOriginFrame(const Eigen::Vector3d& xyz, const Eigen
   frame.linear() = Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
   frame.translation() = xyz;
   return frame;
+}
+
+/// Reads the whole file at @p path into @p text in one read (no stream copies); false when it cannot be read.
+inline bool readWholeFile(const std::string& path, std::string& text) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr)
+    return false;
+  text.clear();
+  char buffer[1 << 16];
+  if (std::fseek(file, 0, SEEK_END) == 0) {
+    const long size = std::ftell(file);
+    if (size > 0)
+      text.reserve(static_cast<size_t>(size));
+    std::rewind(file);
+  }
+  bool ok = true;
+  while (true) {
+    const size_t got = std::fread(buffer, 1, sizeof(buffer), file);
+    text.append(buffer, got);
+    if (got < sizeof(buffer)) {
+      ok = std::ferror(file) == 0;
+      break;
+    }
+  }
+  std::fclose(file);
+  return ok;
 }
 
 /// @return The base name of @p path (what diagnostics show).
