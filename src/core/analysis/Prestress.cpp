@@ -109,6 +109,47 @@ struct BallWorkspace {
   int stamp = 0;
 };
 
+/// The rows of a ball that can carry a state: a row alone on one of its coordinates (within the ball) has
+/// multiplier 0 in every state of the ball, so it goes, and so on inwards. Row i's triplets are
+/// [rowStart[i], rowStart[i + 1]) (one entry past the last row). Returns 1 for each row that stays.
+std::vector<char> peelLonelyRows(const std::vector<Eigen::Triplet<double>>& triplets,
+                                 const std::vector<int>& rowStart, int numRows, size_t numColumns) {
+  std::vector<int> count(numColumns + 1, 0);  // then the start of each column's rows
+  for (const Eigen::Triplet<double>& t : triplets)
+    ++count[static_cast<size_t>(t.col())];
+  std::vector<int> columnStart(numColumns + 1, 0), columnRows(triplets.size());
+  for (size_t c = 0; c < numColumns; ++c)
+    columnStart[c + 1] = columnStart[c] + count[c];
+  {
+    std::vector<int> fill(columnStart.begin(), columnStart.end() - 1);
+    for (const Eigen::Triplet<double>& t : triplets)
+      columnRows[static_cast<size_t>(fill[static_cast<size_t>(t.col())]++)] = t.row();
+  }
+  std::vector<char> alive(static_cast<size_t>(numRows), 1);
+  std::vector<int> lonely;
+  for (size_t c = 0; c < numColumns; ++c) {
+    if (count[c] == 1)
+      lonely.push_back(columnRows[static_cast<size_t>(columnStart[c])]);
+  }
+  while (!lonely.empty()) {
+    const int i = lonely.back();
+    lonely.pop_back();
+    if (!alive[static_cast<size_t>(i)])
+      continue;
+    alive[static_cast<size_t>(i)] = 0;
+    for (int e = rowStart[static_cast<size_t>(i)]; e < rowStart[static_cast<size_t>(i) + 1]; ++e) {
+      const size_t c = static_cast<size_t>(triplets[static_cast<size_t>(e)].col());
+      if (--count[c] != 1)
+        continue;
+      for (int k = columnStart[c]; k < columnStart[c + 1]; ++k) {
+        if (alive[static_cast<size_t>(columnRows[static_cast<size_t>(k)])])
+          lonely.push_back(columnRows[static_cast<size_t>(k)]);
+      }
+    }
+  }
+  return alive;
+}
+
 /**
  * A state of self-stress through cable row @p seed that puts no cable in compression, from the rows near
  * it: the ball of rows within a growing number of layers (two rows are neighbours when they share a
@@ -173,42 +214,8 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
     rowStart.push_back(static_cast<int>(triplets.size()));  // end of the last row, popped below
     if (static_cast<int>(columns.size()) > kMaxBallColumns)
       return std::nullopt;
-    // Peel: a row alone on one of its coordinates (within the ball) has multiplier 0 in every state of the
-    // ball, so it goes, and so on inwards; what stays is where the ball's states can be.
-    const size_t numColumns = columns.size();
-    std::vector<int> count(numColumns + 1, 0);  // then the start of each column's rows
-    for (const Eigen::Triplet<double>& t : triplets)
-      ++count[static_cast<size_t>(t.col())];
-    std::vector<int> columnStart(numColumns + 1, 0), columnRows(triplets.size());
-    for (size_t c = 0; c < numColumns; ++c)
-      columnStart[c + 1] = columnStart[c] + count[c];
-    {
-      std::vector<int> fill(columnStart.begin(), columnStart.end() - 1);
-      for (const Eigen::Triplet<double>& t : triplets)
-        columnRows[static_cast<size_t>(fill[static_cast<size_t>(t.col())]++)] = t.row();
-    }
-    std::vector<char> alive(static_cast<size_t>(numRows), 1);
-    std::vector<int> lonely;
-    for (size_t c = 0; c < numColumns; ++c) {
-      if (count[c] == 1)
-        lonely.push_back(columnRows[static_cast<size_t>(columnStart[c])]);
-    }
-    while (!lonely.empty()) {
-      const int i = lonely.back();
-      lonely.pop_back();
-      if (!alive[static_cast<size_t>(i)])
-        continue;
-      alive[static_cast<size_t>(i)] = 0;
-      for (int e = rowStart[static_cast<size_t>(i)]; e < rowStart[static_cast<size_t>(i) + 1]; ++e) {
-        const size_t c = static_cast<size_t>(triplets[static_cast<size_t>(e)].col());
-        if (--count[c] != 1)
-          continue;
-        for (int k = columnStart[c]; k < columnStart[c + 1]; ++k) {
-          if (alive[static_cast<size_t>(columnRows[static_cast<size_t>(k)])])
-            lonely.push_back(columnRows[static_cast<size_t>(k)]);
-        }
-      }
-    }
+    // Peel the rows that cannot carry a state; what stays is where the ball's states can be.
+    const std::vector<char> alive = peelLonelyRows(triplets, rowStart, numRows, columns.size());
     rowStart.pop_back();
     if (!alive[0])
       continue;  // no state through the seed yet
