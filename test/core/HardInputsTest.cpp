@@ -20,22 +20,10 @@
 #include "core/CliRun.hpp"
 #include "core/JsonCheck.hpp"
 #include "core/TestModels.hpp"
+#include "TextFile.hpp"
 
 namespace mobility_analysis {
 namespace {
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-std::string writeFile(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "hard_inputs_" + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
 
 /// The error lines of a failed run (warnings, "warning: ...", aside).
 int errorLines(const std::string& err) {
@@ -64,7 +52,7 @@ std::string analyse(const std::string& text, const JointPositions& positions,
 
 /// The parallelogram of test/fixtures/hard/far_link.urdf without its far link, plus @p extra before </robot>.
 std::string parallelogramWith(const std::string& extra) {
-  const std::string text = readText(fixturePath("hard/far_link.urdf"));
+  const std::string text = readTextFile(fixturePath("hard/far_link.urdf"));
   const size_t far = text.find("  <link name=\"far\"/>");
   return text.substr(0, far) + extra + "\n</robot>\n";
 }
@@ -84,7 +72,7 @@ TEST(HardInputs, aNameThatIsNotUtf8GivesValidJson) {
 }
 
 TEST(HardInputs, aDiagnosticNamingSomethingThatIsNotUtf8IsOneLineOfText) {
-  std::string text = readText(fixturePath("hard/invalid_utf8_name.urdf"));
+  std::string text = readTextFile(fixturePath("hard/invalid_utf8_name.urdf"));
   text = std::regex_replace(text, std::regex("<link2 link=\"ground\""), "<link2 link=\"gr\xc3\x28ound\"");
   const Result<Mechanism> m = readMechanismFromString(text, "bad\xe2\x82.urdf");
   ASSERT_FALSE(isOk(m));
@@ -199,7 +187,7 @@ TEST(LengthRange, theAbsoluteEdgeHoldsForAModelThatIsAllThatBig) {
 TEST(DrivenRange, aPrismaticValueBeyondAThousandCharacteristicLengthsIsRefusedAtOnce) {
   // urdf/rppr.urdf: link2 slides along AD; slide_1 = 1e5 m ran the continuation out of steps (3 s) and was
   // reported as "stops at 1845.6 m (a dead point ...)", which it is not.
-  const std::string text = readText(urdfPath("rppr.urdf"));
+  const std::string text = readTextFile(urdfPath("rppr.urdf"));
   MobilityReport report;
   ASSERT_EQ(analyse(text, {}, &report), "");
   const double lc = report.characteristicLength;
@@ -224,7 +212,7 @@ TEST(DrivenRange, aPrismaticValueBeyondAThousandCharacteristicLengthsIsRefusedAt
 TEST(DrivenRange, aRevoluteValueIsBoundedByTheAbsoluteRangeOnly) {
   // An angle is reduced to its representative: 1e12 rad is a valid (if odd) crank angle of the four-bar.
   MobilityReport report;
-  const std::string text = readText(urdfPath("four_bar.urdf"));
+  const std::string text = readTextFile(urdfPath("four_bar.urdf"));
   ASSERT_EQ(analyse(text, {{"ground_crank", 1e12}}, &report), "");
   EXPECT_EQ(report.dof, 1);
   const Mechanism four = loadOrFail(urdfPath("four_bar.urdf"));

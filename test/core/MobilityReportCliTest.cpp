@@ -11,19 +11,9 @@
 
 #include "core/CliRun.hpp"
 #include "core/TestModels.hpp"
+#include "TextFile.hpp"
 
 using namespace mobility_analysis;
-
-namespace {
-
-std::string readTextFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-}  // namespace
 
 TEST(MobilityReportCli, JsonEqualsTheCoreReport) {
   const std::string path = fixturePath("four_bar_closed.urdf");

@@ -11,6 +11,7 @@
 
 #include "core/TestModels.hpp"
 #include "mobility_analysis/CouplingEquation.hpp"
+#include "TextFile.hpp"
 
 using namespace mobility_analysis;
 
@@ -18,13 +19,6 @@ namespace {
 
 std::string formatPath(const std::string& name) {
   return fixturePath("formats/" + name);
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 std::string writeTemp(const std::string& name, const std::string& text) {
@@ -183,13 +177,13 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Readers, WithoutItsLoopsEachModelIsTheOpenTreeItWouldBeAnalysedAsToday) {
   // The complaint: loops dropped silently give the tree's DOF. Our readers give these only when the
   // loop really is absent (the loop text removed), and then nothing warns.
-  std::string plus = readText(formatPath("four_bar_urdfplus.urdf"));
+  std::string plus = readTextFile(formatPath("four_bar_urdfplus.urdf"));
   plus = std::regex_replace(plus, std::regex("<loop [\\s\\S]*</loop>"), "");
   const Result<Mechanism> tree = readMechanismFromString(plus, "tree.urdf");
   ASSERT_TRUE(isOk(tree));
   EXPECT_EQ(reportOf(valueOf(tree), AnalysisMode::Auto).dof, 3);
   EXPECT_EQ(reportOf(readOrFail(formatPath("five_bar_gepetto.urdf")), AnalysisMode::Auto).dof, 5);
-  std::string gripper = readText(formatPath("gripper_mimic.urdf"));
+  std::string gripper = readTextFile(formatPath("gripper_mimic.urdf"));
   gripper = std::regex_replace(gripper, std::regex("<mimic[^>]*/>"), "");
   EXPECT_EQ(reportOf(valueOf(readMechanismFromString(gripper, "g.urdf")), AnalysisMode::Spatial).dof, 2);
   // The Gepetto trees without their closure files: the Delta's 3 motors + 7 balls * 3, the Cassie-like
@@ -605,7 +599,7 @@ TEST(Diagnostics, EveryErrorClassWithAHostileNameGivesOneLine) {
 // ---------------------------------
 
 TEST(Numbers, OutOfRangeCoordinatesAndPositionsAreRefusedWhereTheyEnter) {
-  std::string text = readText(formatPath("four_bar_loop_joint.urdf"));
+  std::string text = readTextFile(formatPath("four_bar_loop_joint.urdf"));
   const std::string far = std::regex_replace(text, std::regex("xyz=\"0.4 0 0\""), "xyz=\"0.4 0 1e308\"");
   const Result<Mechanism> m = readMechanismFromString(far, "far.urdf");
   ASSERT_FALSE(isOk(m));
@@ -856,7 +850,7 @@ TEST(SdfReader, NeverSilentAndRefusalsAreOneLine) {
 
 TEST(SdfReader, TheFrontDoorKnowsSdfByItsRootOrItsExtension) {
   // The same four-bar from the file, from its text, and from a copy whose name ends in .sdf.
-  const std::string text = readText(formatPath("four_bar.sdf"));
+  const std::string text = readTextFile(formatPath("four_bar.sdf"));
   const Result<Mechanism> fromText = readMechanismFromString(text, "robot_description");
   ASSERT_TRUE(isOk(fromText)) << diagnosticOf(fromText).toString();
   EXPECT_EQ(valueOf(fromText).name, "four_bar_sdf");
@@ -870,7 +864,7 @@ TEST(SdfReader, TheFrontDoorKnowsSdfByItsRootOrItsExtension) {
 
 TEST(Warnings, AMisspeltLoopInMjcfOrAClosureFileIsNeverAnOpenTree) {
   // MJCF: MuJoCo's schema refuses <conect> (exit 2), so the leg is never read without its plantar loop.
-  std::string mjcf = readText(formatPath("cassie_leg_mjcf.xml"));
+  std::string mjcf = readTextFile(formatPath("cassie_leg_mjcf.xml"));
   mjcf = std::regex_replace(mjcf, std::regex("<connect name=\"plantar\""), "<conect name=\"plantar\"");
   const Result<Mechanism> m = readMechanismFromString(mjcf, "leg.xml");
   ASSERT_FALSE(isOk(m));

@@ -24,16 +24,10 @@
 #include "core/CliRun.hpp"
 #include "core/JsonCheck.hpp"
 #include "core/TestModels.hpp"
+#include "TextFile.hpp"
 
 namespace mobility_analysis {
 namespace {
-
-std::string readTextFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 /// The seed models: every .urdf of urdf/ and every .urdf and .xml under test/fixtures/, sorted by path.
 std::vector<std::string> seedFiles() {

@@ -26,6 +26,7 @@
 #include "mobility_analysis/Move.h"
 #include "mobility_analysis/mobility_analysis.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
+#include "../TextFile.hpp"
 
 using namespace mobility_analysis;
 
@@ -33,13 +34,6 @@ namespace {
 
 constexpr double kWait = 30.0;      ///< Bound of every wait [s].
 constexpr double kAngleTol = 1e-6;  ///< Closed form vs node [rad] (the issue's bound).
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
 
 /// a - b wrapped into (-pi, pi].
 double angleDiff(double a, double b) {
@@ -273,7 +267,7 @@ TEST(MobilityMotion, getDofAnswersFromTheModelInForceWhileALargeMastLoads) {
   ros::ServiceClient getDof = nh.serviceClient<GetDof>(server + "/get_dof", true);
 
   LoadRobot load;
-  load.request.urdf = readFile(mast);
+  load.request.urdf = readTextFile(mast);
   load.request.mode = "spatial";
   std::remove(mast.c_str());
   std::atomic<bool> loading{true};
@@ -312,7 +306,7 @@ TEST(MobilityMotion, getDofAnswersFromTheModelInForceWhileALargeMastLoads) {
 
   // Restore the crank-rocker for the tests that may follow.
   LoadRobot restore;
-  restore.request.urdf = readFile(std::string(MA_URDF_DIR) + "/four_bar.urdf");
+  restore.request.urdf = readTextFile(std::string(MA_URDF_DIR) + "/four_bar.urdf");
   ASSERT_TRUE(ros::service::call(server + "/load_robot", restore));
   EXPECT_TRUE(restore.response.success) << restore.response.message;
   std::string description;
@@ -326,7 +320,7 @@ TEST(MobilityMotion, aLoadLongerThanTheTimeoutIsRefusedAndTheModelStays) {
   const std::string mast = "/tmp/mobility_motion_test_timeout_" + std::to_string(getpid()) + ".urdf";
   ASSERT_EQ(std::system((std::string(MA_GENERATE_EXE) + " sle_spatial 10000 > " + mast).c_str()), 0);
   LoadRobot load;
-  load.request.urdf = readFile(mast);
+  load.request.urdf = readTextFile(mast);
   load.request.mode = "spatial";
   std::remove(mast.c_str());
   ASSERT_TRUE(ros::service::waitForService("/timeout/mobility_server/load_robot", ros::Duration(kWait)));

@@ -30,6 +30,7 @@
 
 #include "mobility_analysis/mobility_analysis.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
+#include "../TextFile.hpp"
 
 extern char** environ;
 
@@ -46,13 +47,6 @@ struct Config {
 };
 Config config;
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
 /// How the launched node reads its model: with its closure file, if any.
 ReadOptions readOptions() {
   ReadOptions options;
@@ -63,7 +57,7 @@ ReadOptions readOptions() {
 /// The report the core computes in-process for the launched model, as the node read it.
 MobilityReport expectedReport() {
   const Result<Mechanism> mechanism =
-      readMechanismFromString(readFile(config.urdfFile), "robot_description", readOptions());
+      readMechanismFromString(readTextFile(config.urdfFile), "robot_description", readOptions());
   EXPECT_TRUE(isOk(mechanism));
   AnalysisOptions options;
   options.mode = valueOf(parseAnalysisMode(config.modeText));
@@ -384,14 +378,14 @@ TEST(MobilityServer, loadRobotSwapsOnlyOnSuccessAndRepublishes) {
   MarkerCatcher markers(nh);
   ASSERT_TRUE(markers.waitBeyond(0));
   const int before = markers.count();
-  const std::string original = readFile(config.urdfFile);
+  const std::string original = readTextFile(config.urdfFile);
   const MobilityReport expected = expectedReport();
 
   struct BadLoad {
     std::string urdf, mode, mustMention;
   };
   const std::vector<BadLoad> bad = {
-      {readFile(std::string(MA_FIXTURE_DIR) + "/ros_bad_unknown_link.urdf"), "auto", "rockr"},
+      {readTextFile(std::string(MA_FIXTURE_DIR) + "/ros_bad_unknown_link.urdf"), "auto", "rockr"},
       {"this is not XML", "auto", "load_robot"},
       {original, "sideways", "sideways"},
       {"", "", "load_robot"},
@@ -409,7 +403,7 @@ TEST(MobilityServer, loadRobotSwapsOnlyOnSuccessAndRepublishes) {
   const std::string unclosable = std::string(MA_FIXTURE_DIR) + "/bad_unclosable.urdf";
   if (access(unclosable.c_str(), R_OK) == 0) {
     LoadRobot load;
-    load.request.urdf = readFile(unclosable);
+    load.request.urdf = readTextFile(unclosable);
     ASSERT_TRUE(call("load_robot", load));
     EXPECT_FALSE(load.response.success);
     EXPECT_NE(load.response.message.find("j4"), std::string::npos) << load.response.message;
@@ -424,7 +418,7 @@ TEST(MobilityServer, loadRobotSwapsOnlyOnSuccessAndRepublishes) {
 
   // A good one: the fixture 4-bar analysed in the other mode, so the answer and the markers change.
   LoadRobot good;
-  good.request.urdf = readFile(std::string(MA_FIXTURE_DIR) + "/ros_four_bar.urdf");
+  good.request.urdf = readTextFile(std::string(MA_FIXTURE_DIR) + "/ros_four_bar.urdf");
   good.request.mode = config.expectRedundant ? "planar" : "spatial";
   ASSERT_TRUE(call("load_robot", good));
   ASSERT_TRUE(good.response.success) << good.response.message;
@@ -478,7 +472,7 @@ TEST(MobilityServer, theLoadRobotToolLoadsEveryBundledModel) {
   EXPECT_NE(bad.find("rockr"), std::string::npos) << bad;
   // Restore the launched model for the other tests.
   LoadRobot restore;
-  restore.request.urdf = readFile(config.urdfFile);
+  restore.request.urdf = readTextFile(config.urdfFile);
   restore.request.mode = config.modeText;
   ASSERT_TRUE(call("load_robot", restore));
   ASSERT_TRUE(restore.response.success) << restore.response.message;
@@ -568,7 +562,7 @@ TEST(MobilityServer, badDescriptionAtStartUpKeepsServingUntilLoadRobot) {
   EXPECT_FALSE(dof.response.success);
   EXPECT_NE(dof.response.message.find("robot_description"), std::string::npos) << dof.response.message;
   LoadRobot load;
-  load.request.urdf = readFile(config.urdfFile);
+  load.request.urdf = readTextFile(config.urdfFile);
   load.request.mode = config.modeText;
   ASSERT_TRUE(ros::service::call(base + "/load_robot", load));
   EXPECT_TRUE(load.response.success) << load.response.message;

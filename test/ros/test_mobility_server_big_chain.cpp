@@ -18,6 +18,7 @@
 
 #include "../core/TestModels.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
+#include "../TextFile.hpp"
 
 using namespace mobility_analysis;
 
@@ -34,13 +35,6 @@ bool call(const std::string& name, Service& srv) {
       return true;
   }
   return false;
-}
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 }  // namespace
@@ -92,7 +86,7 @@ TEST(MobilityServerBigChain, loadRobotOfA140000LinkChainReportsItsDofAndTheNodeK
 
   // And it still loads a small model afterwards (the four-bar from the bundled files: DOF 1).
   LoadRobot back;
-  back.request.urdf = readFile(urdfPath("four_bar.urdf"));
+  back.request.urdf = readTextFile(urdfPath("four_bar.urdf"));
   ASSERT_TRUE(call("load_robot", back));
   ASSERT_TRUE(back.response.success) << back.response.message;
   EXPECT_EQ(back.response.dof, 1);

@@ -15,6 +15,7 @@
 
 #include "mobility_analysis/mobility_analysis.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
+#include "../TextFile.hpp"
 
 using namespace mobility_analysis;
 
@@ -24,13 +25,6 @@ constexpr double kWait = 30.0;  ///< Bound of the wait for the node's services [
 
 std::string descriptionFile;
 std::string server = "/mobility_server";
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
 
 std::string formatPath(const std::string& name) {
   return std::string(MA_FIXTURE_DIR) + "/formats/" + name;
@@ -75,7 +69,7 @@ TEST(FormatsThroughTheNode, mjcfTextInRobotDescriptionIsReadAsMjcf) {
   EXPECT_TRUE(redundancy.response.warnings.empty());
   MobilityReport served = fromResponse(redundancy.response);
   const MobilityReport expected =
-      coreReport(readFile(descriptionFile), "robot_description", AnalysisMode::Auto);
+      coreReport(readTextFile(descriptionFile), "robot_description", AnalysisMode::Auto);
   served.file = expected.file;
   EXPECT_EQ(toJson(served), toJson(expected));
 }
@@ -106,7 +100,7 @@ TEST(FormatsThroughTheNode, everyUrdfDialectThroughLoadRobotGivesItsDof) {
   };
   for (const DialectLoad& d : loads) {
     SCOPED_TRACE(d.file);
-    const std::string text = readFile(formatPath(d.file));
+    const std::string text = readTextFile(formatPath(d.file));
     ASSERT_FALSE(text.empty());
     LoadRobot load;
     load.request.urdf = text;
@@ -130,7 +124,7 @@ TEST(FormatsThroughTheNode, everyUrdfDialectThroughLoadRobotGivesItsDof) {
 
 TEST(FormatsThroughTheNode, aMisspeltLoopElementIsAWarningInTheResponse) {
   // <loopjoint> is not read: the open tree is served (planar DOF 3), never silently: the response names it.
-  std::string text = readFile(formatPath("four_bar_loop_joint.urdf"));
+  std::string text = readTextFile(formatPath("four_bar_loop_joint.urdf"));
   const std::string open = "<loop_joint name", close = "</loop_joint>";
   ASSERT_NE(text.find(open), std::string::npos);
   text.replace(text.find(open), open.size(), "<loopjoint name");
