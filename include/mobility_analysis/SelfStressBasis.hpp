@@ -34,6 +34,10 @@ struct SelfStressBasis {
   /// elimination; empty with motionsComputed false when there were more than kMaxMotions.
   std::vector<Eigen::VectorXd> motions;
   bool motionsComputed = false;
+  /// The same space again, each stress with a last equation of its own in contract order (findContractEchelon),
+  /// when the sweep's stresses would fill their reduction to that form; else empty. The ordered redundancy
+  /// is read off it (computeOrderedRankFromStresses).
+  std::vector<SelfStress> contractEchelon;
   static constexpr size_t kMaxMotions = 256;
 };
 
