@@ -58,7 +58,9 @@ using ProgressCallback = std::function<void(double)>;
  * combination at the point) and the rows acting on the links they reach as a whole. The sweep runs from the
  * ground; where it fills past a budget (a long ring, whose arcs
  * fill like chains swept from their root) the spanning tree of the sweep is taken from its leaves instead and
- * the loop-closing connections after it, and a tree is always taken from its leaves.
+ * the loop-closing connections after it, and a tree is always taken from its leaves. Where the stresses
+ * found share last equations in contract order and their reduction to echelon form there would fill (a
+ * lattice braced by cables), the basis also carries stresses local in contract order (findContractEchelon).
  * @param[in] mechanism the mechanism.
  * @param[in] model its natural-coordinate model.
  * @param[in] J the constraint Jacobian at the assembled pose (rows in contract order; the basis uses these
@@ -79,7 +81,9 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
  * (\f$ J_r = -\sum_{i<r} y_i J_i / y_r \f$). So the redundant equations are the pivots of the basis reduced
  * to echelon form on each vector's last equation: the rows of the basis matrix Y taken from the last equation
  * up, each one kept when it is independent of the rows after it. Y has one column per redundancy and is as
- * local as the stresses, so this costs little next to finding the basis.
+ * local as the stresses, so this costs little next to finding the basis. Where the basis carries its
+ * contract-order echelon (SelfStressBasis::contractEchelon: each stress with a last equation of its own) that
+ * is reduced instead: every row then reduces against unit pivots, without fill.
  * @param[in] basis the self-stresses of the Jacobian (any basis gives the same answer).
  * @param[in] tolerance threshold for a row of Y (stresses scaled to unit largest coefficient) to be
  * independent of the rows after it.
