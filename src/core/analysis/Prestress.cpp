@@ -367,15 +367,17 @@ CablePrestress findCablePrestress(const std::vector<SelfStress>& states, int num
   for (size_t c = 0; c < cableRows.size(); ++c)
     cableIndex[cableRows[c]] = static_cast<int>(c);
   // A cable that no state touches has multiplier 0 in every combination: no prestress, no LP needed.
-  std::vector<char> touched(cableRows.size(), 0);
+  // (Marked by row, not looked up in cableIndex: a 200 x 200 braced lattice's states have 3.5 10^6 entries.)
+  std::vector<char> touchedRow(static_cast<size_t>(numConstraints), 0);
   for (const SelfStress& state : states) {
     for (const auto& entry : state) {
-      const auto it = cableIndex.find(entry.first);
-      if (it != cableIndex.end())
-        touched[static_cast<size_t>(it->second)] = 1;
+      if (entry.first >= 0 && entry.first < numConstraints)
+        touchedRow[static_cast<size_t>(entry.first)] = 1;
     }
   }
-  if (std::find(touched.begin(), touched.end(), 0) != touched.end()) {
+  if (std::any_of(cableRows.begin(), cableRows.end(), [&](int row) {
+        return row < 0 || row >= numConstraints || touchedRow[static_cast<size_t>(row)] == 0;
+      })) {
     result.decidedBy = PrestressMethod::UntouchedCable;
     return result;
   }
