@@ -181,10 +181,11 @@ int main(int argc, char** argv) {
     const double passiveSeconds = since(passiveStart);
     std::printf(
         "method=finite file=%s coordinates=%d equations=%d dof=%d finite_dof=%d passive_dof=%d plain_seconds=%.4f "
-        "finite_seconds=%.4f passive_seconds=%.4f ratio=%.2f stepped=%d peak_mb=%.1f status=ok\n",
+        "finite_seconds=%.4f passive_seconds=%.4f ratio=%.2f stepped=%d searched_groups=%d rigid_by_ends=%d peak_mb=%.1f "
+        "status=ok\n",
         file.c_str(), a.model.numCoordinates(), a.model.numConstraints(), order.dof(), finite.finiteDof, passive.dof,
         plainSeconds, finiteSeconds, passiveSeconds, (plainSeconds + finiteSeconds + passiveSeconds) / plainSeconds,
-        finite.steppedAndProjected ? 1 : 0, peakMegabytes());
+        finite.steppedAndProjected ? 1 : 0, passive.groupsSearched, passive.groupsRigidByEnds, peakMegabytes());
     return 0;
   } else if (method == "slvs") {
 #ifdef MA_HAVE_SLVS

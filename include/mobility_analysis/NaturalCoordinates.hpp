@@ -26,15 +26,29 @@ enum class EquationSource { Link, Joint, Boundary };
 /// @return "link", "joint" or "boundary".
 const char* toString(EquationSource source);
 
+/// What an element is on its body; with the body and joint names it spells the element's label.
+enum class ElementRole : unsigned char {
+  JointPoint,       ///< "P(link@joint)"
+  JointAxis,        ///< "u(link@joint)"
+  JointSecondAxis,  ///< "v(link@joint)": a universal joint's second axis
+  Origin,           ///< "O(link)"
+  Auxiliary1,       ///< "aux1(link)"
+  Auxiliary2,       ///< "aux2(link)"
+};
+
 /**
  * @brief A basic point or unit vector of one body: the natural coordinates (García de Jalón & Bayo, ch. 3).
+ *
+ * Its label ("P(crank@j2)", "u(crank@j2)", "aux1(rod)") is written on demand by elementLabel: a model of
+ * 10^6 equations only ever names the elements of the equations it reports.
  */
 struct Element {
-  int body = -1;          ///< Link index.
-  bool isPoint = true;    ///< Point or unit vector.
+  int body = -1;        ///< Link index.
+  bool isPoint = true;  ///< Point or unit vector.
+  ElementRole role = ElementRole::JointPoint;
+  int joint = -1;         ///< The joint it sits at (JointPoint, JointAxis, JointSecondAxis), else -1.
   Eigen::Vector3d local;  ///< In the body frame, point divided by the characteristic length.
   int offset = 0;         ///< First coordinate in q.
-  std::string label;      ///< "P(crank@j2)", "u(crank@j2)", "aux1(rod)".
 };
 
 /// A vector of the body as a function of q: element `head`, minus point `tail` when tail >= 0.
@@ -105,10 +119,15 @@ struct CoordinateModel {
   std::vector<int> jointFreedom;  ///< F_i of each connection in this mode (-1: ignored, e.g. slack cable).
   std::vector<bool> jointActive;  ///< Whether a connection contributes equations (cables: taut passive).
   std::vector<std::vector<int>> bodyElements;  ///< Element indices of each link.
+  std::vector<std::string> linkNames;          ///< Per link (the elements' labels).
+  std::vector<std::string> jointNames;         ///< Per connection (the elements' labels).
   Eigen::VectorXd q0;  ///< Coordinates at the pose the model was built at (dim num_coordinates).
   int numCoordinates() const { return static_cast<int>(q0.size()); }
   int numConstraints() const { return static_cast<int>(equations.size()); }
 };
+
+/// @return Element @p element's label, e.g. "P(crank@j2)" (ElementRole).
+std::string elementLabel(const CoordinateModel& model, int element);
 
 /**
  * @brief The readable form of equation @p row, e.g. "|P(crank@j2) - P(crank@j1)|^2 = 1 Lc^2".

@@ -148,90 +148,197 @@ std::string deploymentJson(const DeploymentInfo& d) {
   return out + "]}";
 }
 
-std::string statusJson(const ElementStatus& s) {
-  return "{\"name\": " + quote(s.name) + ", \"kind\": " + quote(s.kind) + ", \"type\": " + quote(s.type) +
-         ", \"class\": " + quote(toString(s.elementClass)) + "}";
-}
-
 }  // namespace
 
 std::string toJson(const MobilityReport& r) {
-  std::ostringstream out;
-  out << "{\n";
-  out << "  \"robot\": " << quote(r.robot) << ",\n";
-  out << "  \"file\": " << quote(r.file) << ",\n";
-  out << "  \"mode\": " << quote(r.mode) << ",\n";
-  out << "  \"lambda\": " << r.lambda << ",\n";
-  out << "  \"dof\": " << r.dof << ",\n";
-  out << "  \"grubler_kutzbach_dof\": " << r.grublerKutzbachDof << ",\n";
-  out << "  \"num_coordinates\": " << r.numCoordinates << ",\n";
-  out << "  \"num_constraints\": " << r.numConstraints << ",\n";
-  out << "  \"rank\": " << r.rank << ",\n";
-  out << "  \"num_redundant\": " << r.numRedundant << ",\n";
-  out << "  \"finite_dof\": " << r.finiteDof << ",\n";
-  out << "  \"singular\": " << (r.singular ? "true" : "false") << ",\n";
-  out << "  \"passive_dof\": " << r.passiveDof << ",\n";
-  out << "  \"output_dof\": " << r.outputDof << ",\n";
-  out << "  \"passive_motions\": "
-      << array(r.passiveMotions,
-               [](const PassiveMotion& m) {
-                 return "{\"links\": " + array(m.links, quote) + ", \"description\": " + quote(m.description) + "}";
-               })
-      << ",\n";
-  out << "  \"nullity_trace\": " << array(r.nullityTrace, [](int v) { return std::to_string(v); }) << ",\n";
-  out << "  \"redundant_constraints\": "
-      << array(r.redundantConstraints,
-               [](const RedundantConstraint& c) {
-                 return "{\"index\": " + std::to_string(c.index) + ", \"source\": " + quote(c.source) +
-                        ", \"name\": " + quote(c.name) + ", \"kind\": " + quote(c.kind) +
-                        ", \"equation\": " + quote(c.equation) + ", \"cause\": " + quote(c.cause) + "}";
-               })
-      << ",\n";
-  out << "  \"redundant_joints\": "
-      << array(r.redundantJoints,
-               [](const RedundantJoint& j) {
-                 return "{\"name\": " + quote(j.name) + ", \"redundant_equations\": " +
-                        std::to_string(j.redundantEquations) + ", \"equations\": " + std::to_string(j.equations) + "}";
-               })
-      << ",\n";
-  out << "  \"redundant_links\": " << array(r.redundantLinks, quote) << ",\n";
-  out << "  \"redundant_links_computed\": " << (r.redundantLinksComputed ? "true" : "false") << ",\n";
-  out << "  \"redundant_boundaries\": " << array(r.redundantBoundaries, quote) << ",\n";
-  out << "  \"links\": " << array(r.links, statusJson) << ",\n";
-  out << "  \"joints\": " << array(r.joints, statusJson) << ",\n";
-  out << "  \"cables\": "
-      << array(r.cables,
-               [](const CableState& c) {
-                 return "{\"name\": " + quote(c.name) + ", \"type\": " + quote(c.type) + ", \"state\": " +
-                        quote(c.state) + ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) +
-                        "}";
-               })
-      << ",\n";
-  out << "  \"rank_margin\": {\"tolerance\": " << number(r.rankMargin.tolerance, 3)
-      << ", \"smallest_kept_pivot\": " << number(r.rankMargin.smallestKeptPivot, 3)
-      << ", \"largest_dropped_residual\": " << number(r.rankMargin.largestDroppedResidual, 3)
-      << ", \"near_tolerance\": " << (r.rankMargin.nearTolerance ? "true" : "false") << "},\n";
-  out << "  \"characteristic_length\": " << number(r.characteristicLength) << ",\n";
-  out << "  \"closure_residual\": {\"before\": " << number(r.closureResidualBefore, 3)
-      << ", \"after\": " << number(r.closureResidualAfter, 3) << "},\n";
-  out << "  \"positions\": {";
-  for (size_t i = 0; i < r.positions.size(); ++i) {
-    out << (i ? ", " : "") << quote(r.positions[i].name) << ": " << number(r.positions[i].value, 12);
+  // One string, appended to in place: the links, joints and positions of a 10^5-link chain are 3 10^5 small
+  // objects, each once built apart and copied in.
+  std::string out;
+  out.reserve(256 + 96 * (r.links.size() + r.joints.size()) + 48 * r.positions.size() +
+              160 * r.redundantConstraints.size());
+  auto integer = [&out](long long value) {
+    char text[24];
+    out.append(text, std::to_chars(text, text + sizeof(text), value).ptr);
+  };
+  auto boolean = [&out](bool value) { out += value ? "true" : "false"; };
+  // "[a, b, …]" with each item appended by @p write.
+  auto list = [&out](const auto& items, auto&& write) {
+    out += '[';
+    for (size_t i = 0; i < items.size(); ++i) {
+      if (i)
+        out += ", ";
+      write(items[i]);
+    }
+    out += ']';
+  };
+  auto quoted = [&out](const std::string& text) { appendQuoted(out, text); };
+  auto field = [&out](const char* name) {  // "  \"name\": "
+    out += "  \"";
+    out += name;
+    out += "\": ";
+  };
+  out += "{\n";
+  field("robot");
+  quoted(r.robot);
+  out += ",\n";
+  field("file");
+  quoted(r.file);
+  out += ",\n";
+  field("mode");
+  quoted(r.mode);
+  out += ",\n";
+  const std::pair<const char*, int> counts[] = {{"lambda", r.lambda},
+                                                {"dof", r.dof},
+                                                {"grubler_kutzbach_dof", r.grublerKutzbachDof},
+                                                {"num_coordinates", r.numCoordinates},
+                                                {"num_constraints", r.numConstraints},
+                                                {"rank", r.rank},
+                                                {"num_redundant", r.numRedundant},
+                                                {"finite_dof", r.finiteDof}};
+  for (const auto& [name, value] : counts) {
+    field(name);
+    integer(value);
+    out += ",\n";
   }
-  out << "},\n";
-  out << "  \"assembly\": {\"residual\": " << number(r.assembly.residual, 3) << ", \"steps\": " << r.assembly.steps
-      << ", \"iterations\": " << r.assembly.iterations << ", \"events\": " << array(r.assembly.events, quote)
-      << "},\n";
-  // The states can be most of the report: appended to one string, not built apart and copied in.
-  std::string text = out.str();
-  text += "  \"self_stress\": ";
-  appendSelfStress(text, r.selfStress);
-  text += ",\n";
+  field("singular");
+  boolean(r.singular);
+  out += ",\n";
+  field("passive_dof");
+  integer(r.passiveDof);
+  out += ",\n";
+  field("output_dof");
+  integer(r.outputDof);
+  out += ",\n";
+  field("passive_motions");
+  list(r.passiveMotions, [&](const PassiveMotion& m) {
+    out += "{\"links\": ";
+    list(m.links, quoted);
+    out += ", \"description\": ";
+    quoted(m.description);
+    out += '}';
+  });
+  out += ",\n";
+  field("nullity_trace");
+  list(r.nullityTrace, [&](int v) { integer(v); });
+  out += ",\n";
+  field("redundant_constraints");
+  list(r.redundantConstraints, [&](const RedundantConstraint& c) {
+    out += "{\"index\": ";
+    integer(c.index);
+    out += ", \"source\": ";
+    quoted(c.source);
+    out += ", \"name\": ";
+    quoted(c.name);
+    out += ", \"kind\": ";
+    quoted(c.kind);
+    out += ", \"equation\": ";
+    quoted(c.equation);
+    out += ", \"cause\": ";
+    quoted(c.cause);
+    out += '}';
+  });
+  out += ",\n";
+  field("redundant_joints");
+  list(r.redundantJoints, [&](const RedundantJoint& j) {
+    out += "{\"name\": ";
+    quoted(j.name);
+    out += ", \"redundant_equations\": ";
+    integer(j.redundantEquations);
+    out += ", \"equations\": ";
+    integer(j.equations);
+    out += '}';
+  });
+  out += ",\n";
+  field("redundant_links");
+  list(r.redundantLinks, quoted);
+  out += ",\n";
+  field("redundant_links_computed");
+  boolean(r.redundantLinksComputed);
+  out += ",\n";
+  field("redundant_boundaries");
+  list(r.redundantBoundaries, quoted);
+  out += ",\n";
+  auto status = [&](const ElementStatus& e) {
+    out += "{\"name\": ";
+    quoted(e.name);
+    out += ", \"kind\": ";
+    quoted(e.kind);
+    out += ", \"type\": ";
+    quoted(e.type);
+    out += ", \"class\": \"";
+    out += toString(e.elementClass);  // a fixed word, nothing to escape
+    out += '"';
+    out += '}';
+  };
+  field("links");
+  list(r.links, status);
+  out += ",\n";
+  field("joints");
+  list(r.joints, status);
+  out += ",\n";
+  field("cables");
+  list(r.cables, [&](const CableState& c) {
+    out += "{\"name\": ";
+    quoted(c.name);
+    out += ", \"type\": ";
+    quoted(c.type);
+    out += ", \"state\": ";
+    quoted(c.state);
+    out += ", \"length\": ";
+    appendNumber(out, c.length);
+    out += ", \"distance\": ";
+    appendNumber(out, c.distance);
+    out += '}';
+  });
+  out += ",\n";
+  field("rank_margin");
+  out += "{\"tolerance\": ";
+  appendNumber(out, r.rankMargin.tolerance, 3);
+  out += ", \"smallest_kept_pivot\": ";
+  appendNumber(out, r.rankMargin.smallestKeptPivot, 3);
+  out += ", \"largest_dropped_residual\": ";
+  appendNumber(out, r.rankMargin.largestDroppedResidual, 3);
+  out += ", \"near_tolerance\": ";
+  boolean(r.rankMargin.nearTolerance);
+  out += "},\n";
+  field("characteristic_length");
+  appendNumber(out, r.characteristicLength);
+  out += ",\n";
+  field("closure_residual");
+  out += "{\"before\": ";
+  appendNumber(out, r.closureResidualBefore, 3);
+  out += ", \"after\": ";
+  appendNumber(out, r.closureResidualAfter, 3);
+  out += "},\n";
+  field("positions");
+  out += '{';
+  for (size_t i = 0; i < r.positions.size(); ++i) {
+    if (i)
+      out += ", ";
+    quoted(r.positions[i].name);
+    out += ": ";
+    appendNumber(out, r.positions[i].value, 12);
+  }
+  out += "},\n";
+  field("assembly");
+  out += "{\"residual\": ";
+  appendNumber(out, r.assembly.residual, 3);
+  out += ", \"steps\": ";
+  integer(r.assembly.steps);
+  out += ", \"iterations\": ";
+  integer(r.assembly.iterations);
+  out += ", \"events\": ";
+  list(r.assembly.events, quoted);
+  out += "},\n";
+  field("self_stress");
+  appendSelfStress(out, r.selfStress);
+  out += ",\n";
   if (r.deployment)
-    text += "  \"deployment\": " + deploymentJson(*r.deployment) + ",\n";
-  text += "  \"warnings\": " + array(r.warnings, quote) + "\n";
-  text += "}\n";
-  return text;
+    out += "  \"deployment\": " + deploymentJson(*r.deployment) + ",\n";
+  field("warnings");
+  list(r.warnings, quoted);
+  out += "\n}\n";
+  return out;
 }
 
 std::string toText(const MobilityReport& r) {

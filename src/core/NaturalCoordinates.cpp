@@ -166,6 +166,12 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
     model.planeE2 = model.planeNormal.cross(model.planeE1);
   }
   model.bodyElements.assign(mechanism.links.size(), {});
+  model.linkNames.reserve(mechanism.links.size());
+  for (const Link& link : mechanism.links)
+    model.linkNames.push_back(link.name);
+  model.jointNames.reserve(mechanism.joints.size());
+  for (const Joint& joint : mechanism.joints)
+    model.jointNames.push_back(joint.name);
   model.jointFreedom.assign(mechanism.joints.size(), 0);
   model.jointActive.assign(mechanism.joints.size(), true);
 
@@ -258,10 +264,30 @@ LinkPoses recoverPoses(const CoordinateModel& model, const Eigen::Ref<const Eige
   return poses;
 }
 
+std::string elementLabel(const CoordinateModel& model, int element) {
+  const Element& e = model.elements[element];
+  const std::string& link = model.linkNames[e.body];
+  switch (e.role) {
+    case ElementRole::JointPoint:
+      return "P(" + link + "@" + model.jointNames[e.joint] + ")";
+    case ElementRole::JointAxis:
+      return "u(" + link + "@" + model.jointNames[e.joint] + ")";
+    case ElementRole::JointSecondAxis:
+      return "v(" + link + "@" + model.jointNames[e.joint] + ")";
+    case ElementRole::Origin:
+      return "O(" + link + ")";
+    case ElementRole::Auxiliary1:
+      return "aux1(" + link + ")";
+    case ElementRole::Auxiliary2:
+      return "aux2(" + link + ")";
+  }
+  return "?";
+}
+
 std::string describeEquation(const CoordinateModel& model, int row) {
   const ConstraintEquation& eq = model.equations[row];
   const bool planar = model.dim == 2;
-  auto label = [&](int element) { return model.elements[element].label; };
+  auto label = [&](int element) { return elementLabel(model, element); };
   auto name = [&](const Direction& d) {
     return d.tail < 0 ? label(d.head) : "(" + label(d.head) + " - " + label(d.tail) + ")";
   };

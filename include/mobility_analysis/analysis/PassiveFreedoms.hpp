@@ -29,6 +29,26 @@ namespace mobility_analysis {
 struct PassiveFreedoms {
   int dof = 0;
   std::vector<PassiveMotion> motions;  ///< One per independent motion, with its group and a phrase.
+  int groupsRigidByEnds = 0;  ///< Candidate groups settled by the end-connection bound (no twist computed).
+  int groupsSearched = 0;     ///< Groups with two end connections reaching two other links, fully searched.
+};
+
+/**
+ * @brief How findPassiveFreedoms searches; the answer is the same either way.
+ *
+ * The end-connection bound. A group's twists xi are tested on A = J(rows touching the group, group columns) T
+ * (rows scaled to unit norm): a twist is a candidate when |A xi| <= 1e-8 max(sigma_max(A), 1) |xi|. Let A' be
+ * the rows of the group's two end connections only, where each such row touches the group's end link and the
+ * link outside (checked; else the bound is not used): these are rows of A, so sigma_min(A) >= sigma_min(A').
+ * With F_l the sum over all rows touching link l of |row on l's columns times T|^2 (computed once per link),
+ * |A|_F^2 <= |group| sum_l F_l (a row of A is a sum of at most |group| per-link parts). When
+ * sigma_min(A')^2 >= 1 / |(A'^T A')^-1|_F clears 1e-6 max(sqrt(|group| sum F_l), 1), a hundredfold above the
+ * test's threshold as in the search's own bound, no twist can be a candidate and the group is settled without
+ * building A. On a serial chain of revolutes every group is settled so: two revolutes at different points
+ * (in space: on different axes) leave a rigid body no twist.
+ */
+struct PassiveFreedomsOptions {
+  bool endConnectionBound = true;  ///< false: every group goes through the full search (for tests).
 };
 
 /**
@@ -37,8 +57,10 @@ struct PassiveFreedoms {
  * @param[in] model its coordinate model.
  * @param[in] q closed coordinates (dim num_coordinates).
  * @param[in] J the constraint Jacobian at q.
+ * @param[in] options the search (the end-connection bound on or off).
  */
 PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const CoordinateModel& model,
-                                    const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J);
+                                    const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J,
+                                    const PassiveFreedomsOptions& options = {});
 
 }  // namespace mobility_analysis

@@ -53,8 +53,9 @@ struct ModelBuilder {
       : mechanism(m), poses(p), model(out) {}
 
   bool planar() const { return model.dim == 2; }
-  /// Adds an element of @p body at @p local (point: divided by Lc) and returns its index.
-  int addElement(int body, bool isPoint, const Eigen::Vector3d& local, std::string label);
+  /// Adds an element of @p body at @p local (point: divided by Lc) and returns its index; @p role and
+  /// @p joint (-1 for the body's own elements) make its label (elementLabel).
+  int addElement(int body, bool isPoint, const Eigen::Vector3d& local, ElementRole role, int joint = -1);
   /// Element @p e in the model's space: the world value, projected on (e1, e2) in the plane (z = 0).
   Eigen::Vector3d coordinates(int e) const;
   /// A direction's value in the model's space.

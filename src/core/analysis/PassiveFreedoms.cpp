@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <set>
 
 #include <Eigen/Dense>
@@ -58,7 +59,8 @@ bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
 }  // namespace
 
 PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const CoordinateModel& model,
-                                    const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J) {
+                                    const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J,
+                                    const PassiveFreedomsOptions& options) {
   PassiveFreedoms result;
   const int numLinks = static_cast<int>(mechanism.links.size());
   const int dim = model.dim;
@@ -77,11 +79,162 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     connectionsAt[mechanism.joints[j].link1].push_back(static_cast<int>(j));
     connectionsAt[mechanism.joints[j].link2].push_back(static_cast<int>(j));
   }
+  const int numCoordinates = model.numCoordinates();
+  // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
+  std::vector<double> rowNorm(static_cast<size_t>(J.rows()));
+  for (Eigen::Index r = 0; r < J.rows(); ++r)
+    rowNorm[static_cast<size_t>(r)] = J.row(r).norm();
+  auto element3 = [&](int e) {
+    const int o = model.elements[e].offset;
+    return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
+  };
+  // The row of T for coordinate k of element e: d(x_k)/d(omega, v), from -[x]x and (points) I; in the plane
+  // the components omega_z, v_x, v_y.
+  auto twistRow = [&](int e, int k) {
+    const int o = model.elements[e].offset;
+    const double point = model.elements[e].isPoint ? 1.0 : 0.0;
+    TwistRow t = TwistRow::Zero();
+    if (planar) {  // omega_z, v_x, v_y of x_k: (-y, 1, 0) and (x, 0, 1) for a point
+      if (k == 0)
+        t.head<3>() << -q(o + 1), point, 0.0;
+      else
+        t.head<3>() << q(o), 0.0, point;
+      return t;
+    }
+    const double x = q(o), y = q(o + 1), z = q(o + 2);
+    if (k == 0)
+      t << 0.0, z, -y, point, 0.0, 0.0;
+    else if (k == 1)
+      t << -z, 0.0, x, 0.0, point, 0.0;
+    else
+      t << y, -x, 0.0, 0.0, 0.0, point;
+    return t;
+  };
+
+  // The end-connection bound (PassiveFreedomsOptions, with its proof): per link l, F_l = the sum over the
+  // rows r touching l of |a_{r,l}|^2, where a_{r,l} is row r (scaled to unit norm) on l's columns times T;
+  // and for each of the two connections of a link that may be in a group, the Gram matrix of a_{r,l} over
+  // that connection's rows, valid when each of those rows touches the connection's two links only.
+  const bool bound = options.endConnectionBound;
+  std::vector<double> linkFrobenius;
+  std::vector<double> endGram;  // per link, per connection slot 0 or 1: lambda x lambda
+  std::vector<char> endValid;   // per link and slot
+  const size_t gramSize = static_cast<size_t>(lambda * lambda);
+  if (bound) {
+    std::vector<int> columnElement(static_cast<size_t>(numCoordinates), -1),
+        columnLink(static_cast<size_t>(numCoordinates), -1);
+    for (size_t l = 0; l < model.bodyElements.size(); ++l) {
+      for (int e : model.bodyElements[l]) {
+        for (int k = 0; k < dim; ++k) {
+          columnElement[static_cast<size_t>(model.elements[e].offset + k)] = e;
+          columnLink[static_cast<size_t>(model.elements[e].offset + k)] = static_cast<int>(l);
+        }
+      }
+    }
+    linkFrobenius.assign(static_cast<size_t>(numLinks), 0.0);
+    endGram.assign(static_cast<size_t>(numLinks) * 2 * gramSize, 0.0);
+    endValid.assign(static_cast<size_t>(numLinks) * 2, 1);
+    auto slotOf = [&](int link, int joint) {
+      const std::vector<int>& at = connectionsAt[link];
+      return at.size() != 2 ? -1 : at[0] == joint ? 0 : at[1] == joint ? 1 : -1;
+    };
+    constexpr size_t kLinksPerRow = 4;
+    std::array<std::pair<int, TwistRow>, kLinksPerRow> perLink;
+    for (Eigen::Index r = 0; r < J.rows(); ++r) {
+      size_t used = 0;
+      bool overflow = false;
+      const double norm = rowNorm[static_cast<size_t>(r)];
+      for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
+        const int l = columnLink[static_cast<size_t>(it.col())];
+        size_t slot = 0;
+        while (slot < used && perLink[slot].first != l)
+          ++slot;
+        if (slot == used) {
+          if (used == kLinksPerRow) {  // a row on more than four links: no bound for the links it touches
+            overflow = true;
+            linkFrobenius[static_cast<size_t>(l)] = std::numeric_limits<double>::infinity();
+            continue;
+          }
+          perLink[used++] = {l, TwistRow::Zero()};
+        }
+        const int e = columnElement[static_cast<size_t>(it.col())];
+        perLink[slot].second +=
+            (it.value() / norm) * twistRow(e, static_cast<int>(it.col()) - model.elements[e].offset);
+      }
+      const ConstraintEquation& eq = model.equations[static_cast<size_t>(r)];
+      const Joint* joint = eq.source == EquationSource::Joint ? &mechanism.joints[eq.element] : nullptr;
+      bool twoLinks = joint != nullptr && !overflow;
+      for (size_t s = 0; s < used; ++s)
+        twoLinks = twoLinks && (perLink[s].first == joint->link1 || perLink[s].first == joint->link2);
+      for (size_t s = 0; s < used; ++s) {
+        const int l = perLink[s].first;
+        linkFrobenius[static_cast<size_t>(l)] +=
+            overflow ? std::numeric_limits<double>::infinity() : perLink[s].second.squaredNorm();
+        if (joint == nullptr)
+          continue;
+        const int end = slotOf(l, eq.element);
+        if (end < 0)
+          continue;
+        const size_t at = static_cast<size_t>(l) * 2 + static_cast<size_t>(end);
+        double* gram = &endGram[at * gramSize];
+        const TwistRow& a = perLink[s].second;
+        for (int r1 = 0; r1 < lambda; ++r1) {
+          for (int c1 = 0; c1 < lambda; ++c1)
+            gram[r1 * lambda + c1] += a(r1) * a(c1);
+        }
+      }
+      if (joint != nullptr && !twoLinks) {  // this connection's rows are not all rows of A on the end link
+        for (int l : {joint->link1, joint->link2}) {
+          const int end = slotOf(l, eq.element);
+          if (end >= 0)
+            endValid[static_cast<size_t>(l) * 2 + static_cast<size_t>(end)] = 0;
+        }
+      }
+    }
+  }
+  // Whether the group's two end connections alone prove that no twist of it passes the nullity test of the
+  // search (PassiveFreedomsOptions): true settles the group with no motion; false decides nothing.
+  auto rigidByEnds = [&](const std::vector<int>& path) {
+    Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+    double frobenius2 = 0.0;
+    int ends = 0;
+    for (int l : path) {
+      frobenius2 += linkFrobenius[static_cast<size_t>(l)];
+      for (size_t s = 0; s < 2; ++s) {
+        const Joint& joint = mechanism.joints[connectionsAt[l][s]];
+        const int other = joint.link1 == l ? joint.link2 : joint.link1;
+        if (std::find(path.begin(), path.end(), other) != path.end())
+          continue;
+        const size_t at = static_cast<size_t>(l) * 2 + s;
+        if (!endValid[at])
+          return false;
+        ++ends;
+        const double* end = &endGram[at * gramSize];
+        for (int r1 = 0; r1 < lambda; ++r1) {
+          for (int c1 = 0; c1 < lambda; ++c1)
+            gram(r1, c1) += end[r1 * lambda + c1];
+        }
+      }
+    }
+    frobenius2 *= static_cast<double>(path.size());
+    if (ends != 2 || !std::isfinite(frobenius2))
+      return false;
+    const double limit = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
+    return planar ? clearlyFullRank<3>(gram, limit) : clearlyFullRank<6>(gram, limit);
+  };
+
   // Candidate groups: every link with two connections but the ground, and chains of such links. Each group's
-  // links sorted and padded with -1, so that the groups sort (and are taken) as sorted vectors would.
+  // links sorted and padded with -1, so that the groups sort (and are taken) as sorted vectors would. A group
+  // the end-connection bound settles has no motion and is not kept (the order of the others is unchanged).
   using Group = std::array<int, kMaxGroup>;
   std::vector<Group> groups;
   auto addGroup = [&](const std::vector<int>& path) {
+    if (path.front() > path.back())
+      return;  // the same links are met from the other end, as the reversed path
+    if (bound && rigidByEnds(path)) {
+      ++result.groupsRigidByEnds;
+      return;
+    }
     Group group;
     group.fill(-1);
     for (size_t i = 0; i < path.size(); ++i) {  // insertion sort of at most kMaxGroup links
@@ -120,24 +273,21 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
   }
   std::sort(groups.begin(), groups.end());
   groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
+  if (groups.empty())
+    return result;
 
-  const Eigen::SparseMatrix<double> Jc = J;  // column access
-  // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
-  std::vector<double> rowNorm(static_cast<size_t>(J.rows()));
-  for (Eigen::Index r = 0; r < J.rows(); ++r)
-    rowNorm[static_cast<size_t>(r)] = J.row(r).norm();
-  auto element3 = [&](int e) {
-    const int o = model.elements[e].offset;
-    return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
-  };
+  // Column access, made when a group first needs it (none does on a serial chain).
+  Eigen::SparseMatrix<double> Jc;
+  bool haveColumns = false;
+  std::vector<char> inGroup(numLinks, 0);
+
   // Motions kept, each as (coordinate, value) over its group's coordinates, and the motions at each link: a
   // group is compared with those sharing one of its links only, and nothing here costs more than the group's
   // neighbourhood (a chain of 10^5 links has 3 10^5 candidate groups).
   std::vector<std::vector<std::pair<int, double>>> accepted;
   std::vector<std::vector<int>> acceptedAt(numLinks);
-  std::vector<char> inGroup(numLinks, 0);
   std::vector<int> localColumn(model.numCoordinates(), -1);
-  Eigen::VectorXd moved = q;
+  Eigen::VectorXd moved;  // q, copied when a first twist is stepped
   // Work space of one group, reused (a chain of 10^5 links has 3 10^5 groups: no allocation per group).
   std::vector<int> group, outside, elements, columns, rows;
   std::vector<TwistRow> twistRows;  // the rows of T below (lambda entries, zero beyond)
@@ -175,30 +325,24 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
     }
     if (outside.size() < 2 || ends != 2)
       continue;
+    ++result.groupsSearched;
     elements.clear();
     for (int l : group)
       elements.insert(elements.end(), model.bodyElements[l].begin(), model.bodyElements[l].end());
     columns.clear();
     twistRows.clear();
-    for (size_t i = 0; i < elements.size(); ++i) {
-      const Eigen::Vector3d x = element3(elements[i]);
-      const bool isPoint = model.elements[elements[i]].isPoint;
-      Eigen::Matrix<double, 3, 6> block;  // d(x)/d(omega, v): -[x]x and (points) I
-      block.leftCols<3>() << 0.0, x.z(), -x.y(), -x.z(), 0.0, x.x(), x.y(), -x.x(), 0.0;
-      block.rightCols<3>() =
-          isPoint ? Eigen::Matrix3d(Eigen::Matrix3d::Identity()) : Eigen::Matrix3d(Eigen::Matrix3d::Zero());
+    for (int e : elements) {
       for (int k = 0; k < dim; ++k) {
-        columns.push_back(model.elements[elements[i]].offset + k);
-        TwistRow t = TwistRow::Zero();
-        if (planar)
-          t.head<3>() << block(k, 2), block(k, 3), block(k, 4);
-        else
-          t = block.row(k);
-        twistRows.push_back(t);
+        columns.push_back(model.elements[e].offset + k);
+        twistRows.push_back(twistRow(e, k));
       }
     }
     // A = J(rows touching the group, group columns) T, rows scaled to unit norm.
     rows.clear();
+    if (!haveColumns) {
+      Jc = J;
+      haveColumns = true;
+    }
     for (int c : columns) {
       for (Eigen::SparseMatrix<double>::InnerIterator it(Jc, c); it; ++it)
         rows.push_back(static_cast<int>(it.row()));
@@ -267,6 +411,8 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
       const double scale = kFiniteStep / std::max(omega.norm(), v.norm());
       const Eigen::Isometry3d g = exponential(scale * omega, scale * v);
       // (moved is q outside the group: one copy for all groups, put back after each.)
+      if (moved.size() == 0)
+        moved = q;
       for (int e : elements) {
         const Eigen::Vector3d x = element3(e);
         const Eigen::Vector3d y = model.elements[e].isPoint ? (g * x).eval() : (g.linear() * x).eval();

@@ -13,7 +13,6 @@ void addBodyBases(ModelBuilder& builder) {
   // p0 and the best-conditioned directions; auxiliary unit vectors where the joints give too few.
   for (size_t b = 0; b < mechanism.links.size(); ++b) {
     const int body = static_cast<int>(b);
-    const std::string& name = mechanism.links[b].name;
     BodyBasis& basis = builder.bases[b];
     for (int e : model.bodyElements[b]) {
       if (model.elements[e].isPoint) {
@@ -22,7 +21,7 @@ void addBodyBases(ModelBuilder& builder) {
       }
     }
     if (basis.p0 < 0) {
-      basis.p0 = builder.addElement(body, true, Eigen::Vector3d::Zero(), "O(" + name + ")");
+      basis.p0 = builder.addElement(body, true, Eigen::Vector3d::Zero(), ElementRole::Origin);
     }
     std::vector<Direction> candidates;
     for (int e : model.bodyElements[b]) {
@@ -47,7 +46,7 @@ void addBodyBases(ModelBuilder& builder) {
         local = (local - n.dot(local) * n).norm() > 0.5 ? (local - n.dot(local) * n).normalized().eval()
                                                         : n.unitOrthogonal();
       }
-      basis.d1 = Direction{builder.addElement(body, false, local, "aux1(" + name + ")"), -1};
+      basis.d1 = Direction{builder.addElement(body, false, local, ElementRole::Auxiliary1), -1};
     }
     if (planar)
       continue;
@@ -68,7 +67,7 @@ void addBodyBases(ModelBuilder& builder) {
       // A rod, or a body whose joint elements are all on one line: its spin needs a second direction.
       const Eigen::Vector3d worldAux = d1.unitOrthogonal();
       basis.d2 = Direction{
-          builder.addElement(body, false, rotation.transpose() * worldAux, "aux2(" + name + ")"), -1};
+          builder.addElement(body, false, rotation.transpose() * worldAux, ElementRole::Auxiliary2), -1};
     }
   }
 }

@@ -88,23 +88,22 @@ std::optional<Diagnostic> addJointElements(ModelBuilder& builder) {
       needAxes |= uses.bothAxes;
       needAxis1 |= uses.axis1;
     }
-    const std::string& n1 = mechanism.links[joint.link1].name;
-    const std::string& n2 = mechanism.links[joint.link2].name;
+    const int at = static_cast<int>(j);
     if (needPoints) {
-      c.point1 = builder.addElement(joint.link1, true, joint.frame1.translation() / lc,
-                                    "P(" + n1 + "@" + joint.name + ")");
-      c.point2 = builder.addElement(joint.link2, true, joint.frame2.translation() / lc,
-                                    "P(" + n2 + "@" + joint.name + ")");
+      c.point1 =
+          builder.addElement(joint.link1, true, joint.frame1.translation() / lc, ElementRole::JointPoint, at);
+      c.point2 =
+          builder.addElement(joint.link2, true, joint.frame2.translation() / lc, ElementRole::JointPoint, at);
     }
     if (needAxes || needAxis1) {
       c.axis1 = builder.addElement(joint.link1, false, joint.frame1.linear() * joint.axis,
-                                   "u(" + n1 + "@" + joint.name + ")");
+                                   ElementRole::JointAxis, at);
     }
     if (needAxes) {
       const bool universal = joint.type == JointType::Universal;
       c.axis2 = builder.addElement(joint.link2, false,
                                    joint.frame2.linear() * (universal ? joint.axis2 : joint.axis),
-                                   (universal ? "v(" : "u(") + n2 + "@" + joint.name + ")");
+                                   universal ? ElementRole::JointSecondAxis : ElementRole::JointAxis, at);
     }
   }
   return std::nullopt;

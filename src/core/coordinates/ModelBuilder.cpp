@@ -2,12 +2,14 @@
 
 namespace mobility_analysis {
 
-int ModelBuilder::addElement(int body, bool isPoint, const Eigen::Vector3d& local, std::string label) {
+int ModelBuilder::addElement(int body, bool isPoint, const Eigen::Vector3d& local, ElementRole role,
+                             int joint) {
   Element e;
   e.body = body;
   e.isPoint = isPoint;
+  e.role = role;
+  e.joint = joint;
   e.local = local;
-  e.label = std::move(label);
   model.elements.push_back(e);
   world.push_back(
       isPoint ? (poses[body].linear() * local + poses[body].translation() / model.characteristicLength)
