@@ -216,8 +216,8 @@ TEST(RedundancyAnalysis, ContractOrderOnTheDeployedRingPantographNet) {
   // 500 units (the report falls back to the contract order here: the sweep's basis is ambiguous). Threshold
   // pivoting got 8 equations wrong at 250 units; strict pivoting alone swaps pin_ba_499's x with the last
   // boundary row at 500 (a dependent row's reduced norm is 1.3e-8 of rounding), which the re-check by
-  // orthogonal distance puts right. SuiteSparse QR in contract order (Heath's rank test) agrees at 120, 250,
-  // 500 and 1 000 units (bench/RESULTS.md).
+  // orthogonal distance puts right. SuiteSparse QR of J^T in contract column order (SPQR_ORDERING_FIXED,
+  // Heath's rank test, the dense method's residual) gave this set at 120, 250, 500 and 1 000 units.
   const int units = 500;
   const Assembled large = assemblePlanar(makeRingPantographNet(units, 60));
   const OrderedRank ranks = computeOrderedRank(large.J, tolerances::kRank, false);
