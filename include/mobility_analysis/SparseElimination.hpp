@@ -39,8 +39,11 @@ class SparseElimination {
    * @param[in] columnPriority pivot preference of each column, lower first (dim n); empty: the column index.
    * @param[in] tolerance relative threshold: a row whose reduced norm is at most this is dependent [-].
    * @param[in] keepMultipliers whether to keep what traceDependency needs.
+   * @param[in] pivotThreshold any entry at least this fraction of the reduced row's largest may be its pivot
+   * (tolerances::kPivotThreshold by default; 1: strict partial pivoting, the largest entry).
    */
-  SparseElimination(int numColumns, std::vector<int> columnPriority, double tolerance, bool keepMultipliers);
+  SparseElimination(int numColumns, std::vector<int> columnPriority, double tolerance, bool keepMultipliers,
+                    double pivotThreshold = -1.0);
 
   /// What adding one row found.
   struct Step {
@@ -55,6 +58,28 @@ class SparseElimination {
    * Afterwards multipliers() holds the reduction, J_r scale = sum_k m_k P_k + residual.
    */
   Step addRow(const SparseJacobian& J, int r, double scale);
+
+  /**
+   * @brief The first half of addRow: reduces row @p r of @p J, multiplied by @p scale, and says what was
+   * found, without keeping anything. keep() then keeps it as a pivot row, whatever step.dependent said; the
+   * next reduce or addRow forgets it.
+   */
+  Step reduce(const SparseJacobian& J, int r, double scale);
+  /// Keeps the row reduce() last reduced as a pivot row (its reduced norm must be positive).
+  void keep();
+
+  /**
+   * @brief The distance of row @p r of @p J, multiplied by @p scale, from the span of the pivot rows: the
+   * residual an orthogonal (Gram–Schmidt) test would compare with the tolerance.
+   *
+   * addRow's residual is the reduced row, zero at the pivot columns; it is never below this distance, and
+   * where the pivot rows are nearly dependent (a long ring) it carries their rounding, amplified. The
+   * distance is read off a basis of the right null space of the pivot rows (nullSpace), orthonormalised:
+   * |Q^T x|. Cost: the fill per free column.
+   * @param[in] maxNullity give up (return nothing) when more than this many columns hold no pivot.
+   */
+  std::optional<double> distanceFromPivotRows(const SparseJacobian& J, int r, double scale,
+                                              size_t maxNullity) const;
 
   /// Multipliers (pivot k, m_k) of the last row added.
   const std::vector<std::pair<int, double>>& multipliers() const { return multipliers_; }
@@ -90,6 +115,7 @@ class SparseElimination {
 
   std::vector<int> columnPriority_;
   double tolerance_;
+  double pivotThreshold_;
   bool keepMultipliers_;
 
   // Pivot rows P_k = scale J_origin(k) - sum_j m_kj P_j, pooled: entries of P_k are
@@ -113,6 +139,7 @@ class SparseElimination {
 
   double smallestKept_ = -1.0;
   double largestDropped_ = 0.0;
+  int reducedRow_ = -1;  ///< The row the workspace holds reduced (reduce).
 };
 
 }  // namespace mobility_analysis

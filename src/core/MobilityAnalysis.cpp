@@ -81,6 +81,8 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
     progress("self-stresses", 0.3 + 0.5 * fraction);
   });
   progress("ordered redundancy", 0.8);
+  // When the basis is numerically ambiguous, the lecture's test itself in contract order decides (strict
+  // partial pivoting, near-tolerance rows re-checked by their orthogonal distance: RedundancyAnalysis.hpp).
   std::optional<OrderedRank> fromStresses = computeOrderedRankFromStresses(basis, tolerance);
   const bool ambiguousBasis = !fromStresses.has_value();
   const OrderedRank ranks = fromStresses ? std::move(*fromStresses) : computeOrderedRank(J, tolerance, false);
@@ -126,8 +128,11 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   report.rankMargin.tolerance = tolerance;
   report.rankMargin.smallestKeptPivot = ranks.smallestKeptPivot;
   report.rankMargin.largestDroppedResidual = ranks.largestDroppedResidual;
+  // The margins are those of the decisions the answer came from. When the basis was ambiguous the answer is
+  // the contract-order elimination's, whose near-tolerance decisions are re-checked by their orthogonal
+  // distance (computeOrderedRank); it is near when one could not be, or when the sweep found another rank.
   report.rankMargin.nearTolerance =
-      ambiguousBasis ||
+      ranks.uncheckedNearDecisions > 0 || (ambiguousBasis && basis.rank != ranks.rank) ||
       (ranks.smallestKeptPivot > 0.0 &&
        ranks.smallestKeptPivot < tolerance * tolerances::kNearDecisionFactor) ||
       (ranks.largestDroppedResidual > tolerance / tolerances::kNearDecisionFactor);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include <Eigen/Dense>
 
@@ -41,7 +42,9 @@ OrderedRank computeSparseElimination(const SparseJacobian& J, double tolerance,
   const bool scaled = options.rowScale.size() == m;
   result.nullityTrace.resize(rowOrder.size());
 
-  SparseElimination elimination(n, options.columnPriority, tolerance, options.computeDependencies);
+  SparseElimination elimination(n, options.columnPriority, tolerance, options.computeDependencies,
+                                options.pivotThreshold);
+  double smallestKept = -1.0, largestDropped = 0.0;
   for (size_t position = 0; position < rowOrder.size(); ++position) {
     const int r = rowOrder[position];
     if (options.stopAtFullRank && elimination.rank() == n) {
@@ -56,24 +59,45 @@ OrderedRank computeSparseElimination(const SparseJacobian& J, double tolerance,
       const double norm = J.row(r).norm();
       scale = norm > 0.0 ? 1.0 / norm : 0.0;
     }
-    const SparseElimination::Step step = elimination.addRow(J, r, scale);
-    if (step.dependent) {
+    const SparseElimination::Step step = elimination.reduce(J, r, scale);
+    bool dependent = step.dependent;
+    double residual = step.residual;
+    const bool near = residual > tolerance / tolerances::kNearDecisionFactor &&
+                      residual < tolerance * tolerances::kNearDecisionFactor;
+    if (near && options.recheckNearTolerance) {
+      const std::optional<double> distance =
+          elimination.distanceFromPivotRows(J, r, scale, options.maxRecheckNullity);
+      if (distance) {
+        // The distance is never above the reduced norm but for rounding: a row found dependent stays so.
+        residual = dependent ? std::min(residual, *distance) : *distance;
+        dependent = residual <= tolerance;
+      } else {
+        ++result.uncheckedNearDecisions;
+      }
+    }
+    if (dependent) {
+      largestDropped = std::max(largestDropped, residual);
       result.redundant[r] = true;
       if (options.computeDependencies) {
         result.dependencies.push_back(*elimination.traceDependency(r, elimination.multipliers()));
       }
+    } else {
+      smallestKept = smallestKept < 0.0 ? residual : std::min(smallestKept, residual);
+      elimination.keep();
     }
     result.nullityTrace[position] = n - elimination.rank();
   }
   result.rank = elimination.rank();
-  result.smallestKeptPivot = elimination.smallestKeptPivot();
-  result.largestDroppedResidual = elimination.largestDroppedResidual();
+  result.smallestKeptPivot = smallestKept < 0.0 ? 0.0 : smallestKept;
+  result.largestDroppedResidual = largestDropped;
   return result;
 }
 
 OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool computeDependencies) {
   EliminationOptions options;
   options.computeDependencies = computeDependencies;
+  options.pivotThreshold = 1.0;
+  options.recheckNearTolerance = true;
   return computeSparseElimination(J, tolerance, options);
 }
 

@@ -165,6 +165,18 @@ class EquationPlaces {
     // Only the cells within the places' bounds (a planar model is one cell thick).
     const Eigen::Vector3i low = cellOf(center - Eigen::Vector3d::Constant(radius)).cwiseMax(lowest_);
     const Eigen::Vector3i high = cellOf(center + Eigen::Vector3d::Constant(radius)).cwiseMin(highest_);
+    // A box with more cells than there are occupied ones (a wide ball over a ring, whose box is mostly empty:
+    // (ring radius / spacing)^2 cells, quadratic in the ring's length) is read by its occupied cells instead.
+    const Eigen::Vector3d extent = (high - low + Eigen::Vector3i::Ones()).cast<double>();
+    if (extent.x() * extent.y() * extent.z() > static_cast<double>(cells_.size())) {
+      for (const auto& cell : cells_) {
+        for (int r : cell.second) {
+          if ((place_[r] - center).squaredNorm() <= radius * radius)
+            visit(r);
+        }
+      }
+      return;
+    }
     for (int x = low.x(); x <= high.x(); ++x) {
       for (int y = low.y(); y <= high.y(); ++y) {
         for (int z = low.z(); z <= high.z(); ++z) {

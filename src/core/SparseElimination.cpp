@@ -4,6 +4,8 @@
 #include <cmath>
 #include <queue>
 
+#include <Eigen/QR>
+
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
@@ -33,9 +35,10 @@ std::vector<int> supportOf(const SelfStress& stress) {
 }
 
 SparseElimination::SparseElimination(int numColumns, std::vector<int> columnPriority, double tolerance,
-                                     bool keepMultipliers)
+                                     bool keepMultipliers, double pivotThreshold)
     : columnPriority_(std::move(columnPriority)),
       tolerance_(tolerance),
+      pivotThreshold_(pivotThreshold > 0.0 ? pivotThreshold : tolerances::kPivotThreshold),
       keepMultipliers_(keepMultipliers),
       pivotOfColumn_(numColumns, -1),
       values_(numColumns, 0.0),
@@ -46,6 +49,18 @@ double SparseElimination::smallestKeptPivot() const {
 }
 
 SparseElimination::Step SparseElimination::addRow(const SparseJacobian& J, int r, double scale) {
+  const Step step = reduce(J, r, scale);
+  if (step.dependent) {
+    largestDropped_ = std::max(largestDropped_, step.residual);
+  } else {
+    smallestKept_ = smallestKept_ < 0.0 ? step.residual : std::min(smallestKept_, step.residual);
+    keep();
+  }
+  return step;
+}
+
+SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r, double scale) {
+  reducedRow_ = r;
   for (int c : touched_) {
     values_[c] = 0.0;
     present_[c] = 0;
@@ -97,29 +112,31 @@ SparseElimination::Step SparseElimination::addRow(const SparseJacobian& J, int r
   for (int k : visited_)
     queued_[k] = 0;
 
-  double squared = 0.0, largest = 0.0;
-  for (int c : touched_) {
+  double squared = 0.0;
+  for (int c : touched_)
     squared += values_[c] * values_[c];
-    largest = std::max(largest, std::abs(values_[c]));
-  }
   Step step;
   step.residual = std::sqrt(squared);
   step.dependent = step.residual <= tolerance_;
-  if (step.dependent) {
-    largestDropped_ = std::max(largestDropped_, step.residual);
-    return step;
-  }
-  smallestKept_ = smallestKept_ < 0.0 ? step.residual : std::min(smallestKept_, step.residual);
-  // Threshold partial pivoting: among entries within kPivotThreshold of the largest, the column of lowest
+  return step;
+}
+
+void SparseElimination::keep() {
+  double largest = 0.0;
+  for (int c : touched_)
+    largest = std::max(largest, std::abs(values_[c]));
+  if (!(largest > 0.0))
+    return;  // nothing to pivot on: a zero row is dependent whatever the tolerance
+  // Threshold partial pivoting: among entries within pivotThreshold_ of the largest, the column of lowest
   // priority.
   int pivotColumn = -1;
   for (int c : touched_) {
-    if (std::abs(values_[c]) >= tolerances::kPivotThreshold * largest &&
+    if (std::abs(values_[c]) >= pivotThreshold_ * largest &&
         (pivotColumn < 0 || priority(c) < priority(pivotColumn))) {
       pivotColumn = c;
     }
   }
-  origin_.push_back(r);
+  origin_.push_back(reducedRow_);
   column_.push_back(pivotColumn);
   pivot_.push_back(values_[pivotColumn]);
   for (int c : touched_) {
@@ -132,7 +149,25 @@ SparseElimination::Step SparseElimination::addRow(const SparseJacobian& J, int r
   multiplierStart_.push_back(pivotMultipliers_.size());
   pivotOfColumn_[pivotColumn] = rank() - 1;
   queued_.push_back(0);
-  return step;
+}
+
+std::optional<double> SparseElimination::distanceFromPivotRows(const SparseJacobian& J, int r, double scale,
+                                                               size_t maxNullity) const {
+  const std::optional<std::vector<Eigen::VectorXd>> basis = nullSpace(maxNullity);
+  if (!basis)
+    return std::nullopt;
+  if (basis->empty())
+    return 0.0;
+  Eigen::MatrixXd N(numColumns(), static_cast<Eigen::Index>(basis->size()));
+  for (size_t k = 0; k < basis->size(); ++k)
+    N.col(static_cast<Eigen::Index>(k)) = (*basis)[k];
+  // Column-pivoted QR: the computed basis vectors can be far from orthogonal (they share pivot columns).
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(N);
+  const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(N.rows(), qr.rank());
+  Eigen::VectorXd projection = Eigen::VectorXd::Zero(Q.cols());
+  for (SparseJacobian::InnerIterator it(J, r); it; ++it)
+    projection += (it.value() * scale) * Q.row(it.col()).transpose();
+  return projection.norm();
 }
 
 std::optional<SelfStress> SparseElimination::traceDependency(
