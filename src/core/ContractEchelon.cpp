@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "EquationGraph.hpp"
+
 namespace mobility_analysis {
 
 namespace {
@@ -36,30 +38,6 @@ bool isFirm(const SelfStress& stress) {
   return !stress.empty() && std::abs(stress.back().second) >= kFirmLast;
 }
 
-/// Which equations belong to which link and connection, and which connections couple which links.
-struct LinkGraph {
-  std::vector<std::vector<int>> linkRows;   ///< Rigid-link and boundary rows of each link.
-  std::vector<std::vector<int>> jointRows;  ///< Rows of each connection.
-  std::vector<std::vector<int>> incident;   ///< Connections with equations at each link.
-
-  LinkGraph(const Mechanism& mechanism, const CoordinateModel& model)
-      : linkRows(mechanism.links.size()),
-        jointRows(mechanism.joints.size()),
-        incident(mechanism.links.size()) {
-    for (int r = 0; r < model.numConstraints(); ++r) {
-      const ConstraintEquation& eq = model.equations[r];
-      (eq.source == EquationSource::Joint ? jointRows : linkRows)[eq.element].push_back(r);
-    }
-    for (size_t j = 0; j < mechanism.joints.size(); ++j) {
-      if (jointRows[j].empty())
-        continue;
-      incident[mechanism.joints[j].link1].push_back(static_cast<int>(j));
-      if (mechanism.joints[j].link2 != mechanism.joints[j].link1)
-        incident[mechanism.joints[j].link2].push_back(static_cast<int>(j));
-    }
-  }
-};
-
 /// A stress scaled to unit largest coefficient, rounding noise dropped, by increasing equation.
 SelfStress normalised(SelfStress stress) {
   std::sort(stress.begin(), stress.end());
@@ -78,7 +56,8 @@ SelfStress normalised(SelfStress stress) {
 /// Balls of links and the contract-order elimination of their equations; workspaces kept across patches.
 class Patches {
  public:
-  Patches(const Mechanism& mechanism, const SparseJacobian& J, const LinkGraph& graph, double tolerance)
+  Patches(const Mechanism& mechanism, const SparseJacobian& J, const core_detail::EquationGraph& graph,
+          double tolerance)
       : mechanism_(mechanism),
         J_(J),
         graph_(graph),
@@ -205,7 +184,7 @@ class Patches {
  private:
   const Mechanism& mechanism_;
   const SparseJacobian& J_;
-  const LinkGraph& graph_;
+  const core_detail::EquationGraph& graph_;
   double tolerance_;
   std::vector<int> distance_;
   std::vector<char> jointTaken_;
@@ -245,7 +224,7 @@ std::optional<std::vector<SelfStress>> findContractEchelon(const Mechanism& mech
   if (result.size() == k)
     return result;
 
-  const LinkGraph graph(mechanism, model);
+  const core_detail::EquationGraph graph(mechanism, model);
   Patches patches(mechanism, J, graph, tolerance);
   // The patches cover every link with an equation in some stress (the redundant equations are among
   // those). Rows first, then their links in one pass: the stresses' entries are many and the equations large.

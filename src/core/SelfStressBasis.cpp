@@ -7,6 +7,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "EquationGraph.hpp"
+
 namespace mobility_analysis {
 
 namespace {
@@ -39,29 +41,6 @@ constexpr size_t kEchelonFillFloor = 100000;
 
 /// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
 constexpr double kStressNoise = 1e-10;
-
-/// Which equations belong to which link and connection, and which connections couple which links.
-struct EquationGraph {
-  std::vector<std::vector<int>> linkRows;   ///< Rigid-link and boundary rows of each link.
-  std::vector<std::vector<int>> jointRows;  ///< Rows of each connection.
-  std::vector<std::vector<int>> incident;   ///< Connections with equations at each link.
-
-  EquationGraph(const Mechanism& mechanism, const CoordinateModel& model)
-      : linkRows(mechanism.links.size()),
-        jointRows(mechanism.joints.size()),
-        incident(mechanism.links.size()) {
-    for (int r = 0; r < model.numConstraints(); ++r) {
-      const ConstraintEquation& eq = model.equations[r];
-      (eq.source == EquationSource::Joint ? jointRows : linkRows)[eq.element].push_back(r);
-    }
-    for (size_t j = 0; j < mechanism.joints.size(); ++j) {
-      if (jointRows[j].empty())
-        continue;
-      incident[mechanism.joints[j].link1].push_back(static_cast<int>(j));
-      incident[mechanism.joints[j].link2].push_back(static_cast<int>(j));
-    }
-  }
-};
 
 /**
  * Where each equation acts, at the pose the model was built at: a joint's equations at the points they
@@ -432,7 +411,7 @@ class LocalStressFinder {
   const EliminationOrder& order_;
   const std::vector<int>& position_;
   double tolerance_;
-  EquationGraph graph_;
+  core_detail::EquationGraph graph_;
   std::vector<int> ball_;
   std::vector<char> inBall_, jointTaken_;
   std::vector<int> columnMap_;
