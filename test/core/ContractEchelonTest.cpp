@@ -20,23 +20,6 @@ using namespace mobility_analysis;
 
 namespace {
 
-struct Model {
-  Mechanism mechanism;
-  AssembledMechanism assembled;
-  SparseJacobian J;
-};
-
-Model buildModel(Mechanism mechanism, AnalysisMode mode) {
-  Model model;
-  model.mechanism = std::move(mechanism);
-  Result<AssembledMechanism> assembled =
-      assembleMechanism(model.mechanism, computeTreePoses(model.mechanism, {}), mode);
-  EXPECT_TRUE(isOk(assembled)) << diagnosticOf(assembled).toString();
-  model.assembled = valueOf(std::move(assembled));
-  model.J = computeConstraintJacobian(model.assembled.model, model.assembled.q);
-  return model;
-}
-
 Mechanism generated(const MechanismDescription& description) {
   const GeneratorResult<std::string> urdf = toClosedLoopUrdf(description, UrdfWriterOptions{false, ""});
   EXPECT_TRUE(std::holds_alternative<std::string>(urdf));
@@ -87,7 +70,7 @@ Eigen::VectorXd toDense(const SelfStress& stress, const SparseJacobian& J) {
  * contract-order elimination (and to the dense reference when @p dense).
  * @return The echelon's statistics.
  */
-ContractEchelonStats checkEchelon(const Model& m, const std::string& name, bool dense) {
+ContractEchelonStats checkEchelon(const ModelAtTreePose& m, const std::string& name, bool dense) {
   SCOPED_TRACE(name);
   SelfStressBasis basis = computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
   ContractEchelonStats stats;
@@ -149,7 +132,8 @@ TEST(ContractEchelon, BracedLatticesGiveTheDenseOrderedAnswer) {
   // some of the sweep's stresses share last equations in contract order, and the patches find the rest.
   for (const auto& [rows, columns] :
        {std::pair<int, int>{1, 1}, {1, 4}, {2, 2}, {2, 3}, {3, 3}, {4, 5}, {6, 6}, {8, 7}, {12, 12}}) {
-    const Model m = buildModel(generated(makeBarLattice(rows, columns, true)), AnalysisMode::Planar);
+    const ModelAtTreePose m =
+        assembleAtTreePose(generated(makeBarLattice(rows, columns, true)), AnalysisMode::Planar);
     const int stresses =
         static_cast<int>(m.J.rows()) - computeOrderedRank(m.J, tolerances::kRank, false).rank;
     EXPECT_EQ(stresses, 2 * rows * columns - rows - columns + 1);
@@ -167,21 +151,22 @@ TEST(ContractEchelon, RandomlyDisplacedBracedLatticesGiveTheDenseOrderedAnswer) 
   std::mt19937 random(13);
   for (int trial = 0; trial < 6; ++trial) {
     const int rows = 2 + trial % 3, columns = 3 + trial / 2;
-    const Model m =
-        buildModel(generated(displacedBracedLattice(rows, columns, random)), AnalysisMode::Planar);
+    const ModelAtTreePose m =
+        assembleAtTreePose(generated(displacedBracedLattice(rows, columns, random)), AnalysisMode::Planar);
     const int stresses =
         static_cast<int>(m.J.rows()) - computeOrderedRank(m.J, tolerances::kRank, false).rank;
     EXPECT_EQ(stresses, 2 * rows * columns - rows - columns + 1);
     checkEchelon(m, "displaced braced " + std::to_string(rows) + " x " + std::to_string(columns), true);
   }
-  const Model large = buildModel(generated(displacedBracedLattice(10, 11, random)), AnalysisMode::Planar);
+  const ModelAtTreePose large =
+      assembleAtTreePose(generated(displacedBracedLattice(10, 11, random)), AnalysisMode::Planar);
   checkEchelon(large, "displaced braced 10 x 11", false);
 }
 
 TEST(ContractEchelon, WhatItFindsOnOtherMechanismsIsTheContractOrderAnswer) {
   // Where the sweep's stresses already have last equations of their own they are returned as they are;
   // otherwise the patches either prove every redundancy or give up. Either way no answer may differ.
-  auto check = [](const Model& m, const std::string& name) {
+  auto check = [](const ModelAtTreePose& m, const std::string& name) {
     SCOPED_TRACE(name);
     SelfStressBasis basis = computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
     const std::optional<std::vector<SelfStress>> echelon =
@@ -199,16 +184,16 @@ TEST(ContractEchelon, WhatItFindsOnOtherMechanismsIsTheContractOrderAnswer) {
                            "door.urdf", "sarrus.urdf", "bricard.urdf", "goldberg.urdf", "sle_mast.urdf",
                            "hoberman_ring.urdf", "stewart_6sps.urdf"}) {
     for (AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial})
-      check(buildModel(loadOrFail(urdfPath(file)), mode), std::string(file) + " " + toString(mode));
+      check(assembleAtTreePose(loadOrFail(urdfPath(file)), mode), std::string(file) + " " + toString(mode));
   }
   for (int n : {2, 5}) {
-    check(buildModel(generated(makeSleTriangularMast(n)), AnalysisMode::Spatial), "sle_triangular");
-    check(buildModel(generated(makeSleSpatialMast(n)), AnalysisMode::Spatial), "sle_spatial");
-    check(buildModel(generated(makeHobermanRing(n + 3)), AnalysisMode::Spatial), "hoberman spatial");
-    check(buildModel(generated(makeParallelogramGrid(n, n + 2)), AnalysisMode::Planar), "grid");
-    check(buildModel(generated(makeTrussMast(4 * n)), AnalysisMode::Spatial), "truss mast");
-    check(buildModel(generated(makeRing(40 * n)), AnalysisMode::Spatial), "ring in space");
-    check(buildModel(generated(makeBarLattice(n, n + 1)), AnalysisMode::Planar), "bar lattice");
+    check(assembleAtTreePose(generated(makeSleTriangularMast(n)), AnalysisMode::Spatial), "sle_triangular");
+    check(assembleAtTreePose(generated(makeSleSpatialMast(n)), AnalysisMode::Spatial), "sle_spatial");
+    check(assembleAtTreePose(generated(makeHobermanRing(n + 3)), AnalysisMode::Spatial), "hoberman spatial");
+    check(assembleAtTreePose(generated(makeParallelogramGrid(n, n + 2)), AnalysisMode::Planar), "grid");
+    check(assembleAtTreePose(generated(makeTrussMast(4 * n)), AnalysisMode::Spatial), "truss mast");
+    check(assembleAtTreePose(generated(makeRing(40 * n)), AnalysisMode::Spatial), "ring in space");
+    check(assembleAtTreePose(generated(makeBarLattice(n, n + 1)), AnalysisMode::Planar), "bar lattice");
   }
 }
 
@@ -217,7 +202,7 @@ TEST(ContractEchelon, AStressAsLargeAsTheMechanismIsNotFoundInPatches) {
   // sweep's end on the same equation of the closing joint. No patch holds the ring, so nothing can prove the
   // third redundancy locally: the answer is "not found" (the report then reduces the sweep's stresses), never
   // a made-up stress.
-  const Model m = buildModel(generated(makeRing(120)), AnalysisMode::Spatial);
+  const ModelAtTreePose m = assembleAtTreePose(generated(makeRing(120)), AnalysisMode::Spatial);
   const SelfStressBasis basis =
       computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
   ASSERT_EQ(basis.stresses.size(), 3u);
@@ -242,7 +227,7 @@ TEST(ContractEchelon, TheReportOfALargeBracedLatticeReadsLocalStresses) {
   std::pair<size_t, size_t> sizes[2];
   int k = 0;
   for (int n : {40, 80}) {
-    const Model m = buildModel(generated(makeBarLattice(n, n, true)), AnalysisMode::Planar);
+    const ModelAtTreePose m = assembleAtTreePose(generated(makeBarLattice(n, n, true)), AnalysisMode::Planar);
     const SelfStressBasis basis =
         computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
     ASSERT_EQ(static_cast<int>(basis.stresses.size()), 2 * n * n - 2 * n + 1);

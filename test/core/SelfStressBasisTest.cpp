@@ -19,23 +19,6 @@ using namespace mobility_analysis;
 
 namespace {
 
-struct Model {
-  Mechanism mechanism;
-  AssembledMechanism assembled;
-  SparseJacobian J;
-};
-
-Model buildModel(Mechanism mechanism, AnalysisMode mode) {
-  Model model;
-  model.mechanism = std::move(mechanism);
-  Result<AssembledMechanism> assembled =
-      assembleMechanism(model.mechanism, computeTreePoses(model.mechanism, {}), mode);
-  EXPECT_TRUE(isOk(assembled)) << diagnosticOf(assembled).toString();
-  model.assembled = valueOf(std::move(assembled));
-  model.J = computeConstraintJacobian(model.assembled.model, model.assembled.q);
-  return model;
-}
-
 Mechanism generated(const MechanismDescription& description) {
   const GeneratorResult<std::string> urdf = toClosedLoopUrdf(description);
   EXPECT_TRUE(std::holds_alternative<std::string>(urdf));
@@ -54,7 +37,7 @@ Eigen::VectorXd toDense(const SelfStress& stress, const SparseJacobian& J) {
 }
 
 /// Every check of the basis and the ordered answer on one model.
-void checkModel(const Model& m, const std::string& name, bool dense, size_t fillBudget = 0) {
+void checkModel(const ModelAtTreePose& m, const std::string& name, bool dense, size_t fillBudget = 0) {
   SCOPED_TRACE(name);
   const SelfStressBasis basis =
       computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank, {}, fillBudget);
@@ -124,7 +107,7 @@ TEST(SelfStressBasis, OrderedRankFromAnyBasisEqualsTheDenseReferenceOnRandomMatr
 }
 
 TEST(SelfStressBasis, NoStressMeansNothingRedundant) {
-  const Model m = buildModel(loadOrFail(urdfPath("puma560.urdf")), AnalysisMode::Spatial);
+  const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath("puma560.urdf")), AnalysisMode::Spatial);
   const SelfStressBasis basis =
       computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
   EXPECT_TRUE(basis.stresses.empty());
@@ -140,31 +123,31 @@ TEST(SelfStressBasis, EqualsContractOrderAndDenseOnEveryBundledMechanism) {
         "bennett.urdf", "bennett_mm.urdf", "door.urdf", "sarrus.urdf", "bricard.urdf", "goldberg.urdf",
         "rssr.urdf", "sle_mast.urdf", "hoberman_ring.urdf"}) {
     for (AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial}) {
-      checkModel(buildModel(loadOrFail(urdfPath(file)), mode), std::string(file) + " " + toString(mode),
-                 true);
+      checkModel(assembleAtTreePose(loadOrFail(urdfPath(file)), mode),
+                 std::string(file) + " " + toString(mode), true);
     }
   }
 }
 
 TEST(SelfStressBasis, EqualsContractOrderAndDenseOnTheGeneratedFamilies) {
   for (int n : {1, 2, 5, 12}) {
-    checkModel(buildModel(generated(makeSlePlanarMast(n)), AnalysisMode::Planar), "sle_planar planar",
+    checkModel(assembleAtTreePose(generated(makeSlePlanarMast(n)), AnalysisMode::Planar), "sle_planar planar",
                n <= 5);
-    checkModel(buildModel(generated(makeSlePlanarMast(n)), AnalysisMode::Spatial), "sle_planar spatial",
-               n <= 5);
-    checkModel(buildModel(generated(makeHobermanRing(n + 3)), AnalysisMode::Planar), "hoberman planar",
-               n <= 5);
-    checkModel(buildModel(generated(makeHobermanRing(n + 3)), AnalysisMode::Spatial), "hoberman spatial",
-               n <= 5);
-    checkModel(buildModel(generated(makeDoor(n + 1)), AnalysisMode::Spatial), "door spatial", true);
+    checkModel(assembleAtTreePose(generated(makeSlePlanarMast(n)), AnalysisMode::Spatial),
+               "sle_planar spatial", n <= 5);
+    checkModel(assembleAtTreePose(generated(makeHobermanRing(n + 3)), AnalysisMode::Planar),
+               "hoberman planar", n <= 5);
+    checkModel(assembleAtTreePose(generated(makeHobermanRing(n + 3)), AnalysisMode::Spatial),
+               "hoberman spatial", n <= 5);
+    checkModel(assembleAtTreePose(generated(makeDoor(n + 1)), AnalysisMode::Spatial), "door spatial", true);
   }
   for (int n : {1, 2, 4}) {
-    checkModel(buildModel(generated(makeSleTriangularMast(n)), AnalysisMode::Spatial), "sle_triangular",
-               n <= 2);
-    checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Planar), "grid planar",
-               true);
-    checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Spatial), "grid spatial",
-               n <= 2);
+    checkModel(assembleAtTreePose(generated(makeSleTriangularMast(n)), AnalysisMode::Spatial),
+               "sle_triangular", n <= 2);
+    checkModel(assembleAtTreePose(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Planar),
+               "grid planar", true);
+    checkModel(assembleAtTreePose(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Spatial),
+               "grid spatial", n <= 2);
   }
 }
 
@@ -174,7 +157,7 @@ TEST(SelfStressBasis, StressesStayLocalAlongAChainOfLoops) {
   size_t largest = 0, total[2] = {0, 0};
   int k = 0;
   for (int units : {20, 60}) {
-    const Model m = buildModel(generated(makeSleSpatialMast(units)), AnalysisMode::Spatial);
+    const ModelAtTreePose m = assembleAtTreePose(generated(makeSleSpatialMast(units)), AnalysisMode::Spatial);
     const SelfStressBasis basis =
         computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
     ASSERT_EQ(static_cast<int>(basis.stresses.size()), 3 * units);
@@ -193,7 +176,7 @@ TEST(SelfStressBasis, StressesThatRunDownAChainAreFoundAgainLocally) {
   // In the triangular mast some closing connections lie in the next level's loops too, so the traced stress
   // of each level includes the one below; past the trace limit the local elimination takes over, and the
   // basis is still a basis that gives the contract-order answer.
-  const Model m = buildModel(generated(makeSleTriangularMast(30)), AnalysisMode::Spatial);
+  const ModelAtTreePose m = assembleAtTreePose(generated(makeSleTriangularMast(30)), AnalysisMode::Spatial);
   const SelfStressBasis basis =
       computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
   EXPECT_GT(basis.locallyResolved, 0);
@@ -241,7 +224,7 @@ TEST(SelfStressBasis, ALongRingIsTakenFromItsLeavesAndKeepsTheOrderedAnswer) {
     Result<Mechanism> mechanism = loadMechanismFromString(ringUrdf(links), "ring.urdf");
     ASSERT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
     for (AnalysisMode mode : {AnalysisMode::Planar, AnalysisMode::Spatial}) {
-      const Model m = buildModel(valueOf(mechanism), mode);
+      const ModelAtTreePose m = assembleAtTreePose(valueOf(mechanism), mode);
       for (size_t budget : {size_t{0}, size_t{1}}) {
         const std::string name = "ring of " + std::to_string(links) + " " + toString(mode) +
                                  (budget == 1 ? " leaves first" : " from the ground");
@@ -259,13 +242,13 @@ TEST(SelfStressBasis, TheLeavesFirstOrderKeepsTheAnswerOnLoopyMechanisms) {
   // Forced on mechanisms with many loops (where the sweep from the ground is the one kept), the leaves-first
   // order still yields a basis with the contract-order answer.
   for (int n : {1, 3}) {
-    checkModel(buildModel(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Planar),
+    checkModel(assembleAtTreePose(generated(makeParallelogramGrid(n, n + 1)), AnalysisMode::Planar),
                "grid leaves first", true, 1);
-    checkModel(buildModel(generated(makeSleSpatialMast(2 * n)), AnalysisMode::Spatial), "mast leaves first",
-               true, 1);
+    checkModel(assembleAtTreePose(generated(makeSleSpatialMast(2 * n)), AnalysisMode::Spatial),
+               "mast leaves first", true, 1);
   }
   for (const char* file : {"bricard.urdf", "stewart_6sps.urdf", "hoberman_ring.urdf", "door.urdf"})
-    checkModel(buildModel(loadOrFail(urdfPath(file)), AnalysisMode::Spatial), file, true, 1);
+    checkModel(assembleAtTreePose(loadOrFail(urdfPath(file)), AnalysisMode::Spatial), file, true, 1);
 }
 
 namespace {
@@ -288,7 +271,8 @@ TEST(SelfStressBasis, AGridOfContinuousBarsKeepsTheDenseAnswer) {
   // once: 2RC - R - C stresses (the closed form of ParametricFamilies), and the ordered answer must stay the
   // dense method's equation for equation.
   for (const auto& [rows, columns] : {std::pair<int, int>{6, 7}, std::pair<int, int>{8, 8}, {3, 9}}) {
-    const Model m = buildModel(generated(makeParallelogramGrid(rows, columns)), AnalysisMode::Planar);
+    const ModelAtTreePose m =
+        assembleAtTreePose(generated(makeParallelogramGrid(rows, columns)), AnalysisMode::Planar);
     const SelfStressBasis basis =
         computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
     EXPECT_EQ(static_cast<int>(basis.stresses.size()), 2 * rows * columns - rows - columns);
@@ -308,7 +292,7 @@ TEST(SelfStressBasis, ARandomlyDisplacedGridKeepsTheDenseAnswer) {
     MechanismDescription description = makeParallelogramGrid(size, size + 1);
     for (Connection& connection : description.connections)
       connection.frame.translation() += Eigen::Vector3d(shift(random), shift(random), 0.0);
-    checkModel(buildModel(generated(description), AnalysisMode::Planar),
+    checkModel(assembleAtTreePose(generated(description), AnalysisMode::Planar),
                "displaced grid " + std::to_string(size), true);
   }
 }
@@ -318,8 +302,10 @@ TEST(SelfStressBasis, TheStressesOfAGridOfContinuousBarsStayLocal) {
   // entries at 100 x 100, and the ordered answer filled in with them; from 10 x 10 to 20 x 20 the entries
   // grew 7.4 times). Found in space, each is a few cells': the largest does not grow with the grid, and four
   // times the cells hold at most 4.5 times the entries.
-  const Model small = buildModel(generated(makeParallelogramGrid(10, 10)), AnalysisMode::Planar);
-  const Model large = buildModel(generated(makeParallelogramGrid(20, 20)), AnalysisMode::Planar);
+  const ModelAtTreePose small =
+      assembleAtTreePose(generated(makeParallelogramGrid(10, 10)), AnalysisMode::Planar);
+  const ModelAtTreePose large =
+      assembleAtTreePose(generated(makeParallelogramGrid(20, 20)), AnalysisMode::Planar);
   const auto [smallTotal, smallLargest] =
       basisSize(computeSelfStressBasis(small.mechanism, small.assembled.model, small.J, tolerances::kRank));
   const auto [largeTotal, largeLargest] =

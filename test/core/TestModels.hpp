@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -8,8 +9,12 @@
 
 namespace mobility_analysis {
 
-inline std::string urdfPath(const std::string& name) { return std::string(MA_URDF_DIR) + "/" + name; }
-inline std::string fixturePath(const std::string& name) { return std::string(MA_FIXTURE_DIR) + "/" + name; }
+inline std::string urdfPath(const std::string& name) {
+  return std::string(MA_URDF_DIR) + "/" + name;
+}
+inline std::string fixturePath(const std::string& name) {
+  return std::string(MA_FIXTURE_DIR) + "/" + name;
+}
 
 /// Loads a file that must load; fails the test with the diagnostic otherwise.
 inline Mechanism loadOrFail(const std::string& path) {
@@ -32,6 +37,25 @@ inline MobilityAnalysis analyzeOrFail(const std::string& path, AnalysisMode mode
     return MobilityAnalysis{};
   }
   return valueOf(std::move(analysis));
+}
+
+/// A mechanism assembled from its written (tree) pose, with the constraint Jacobian there.
+struct ModelAtTreePose {
+  Mechanism mechanism;
+  AssembledMechanism assembled;
+  SparseJacobian J;
+};
+
+/// Assembles @p mechanism in @p mode from its tree pose; fails the test with the diagnostic when it cannot.
+inline ModelAtTreePose assembleAtTreePose(Mechanism mechanism, AnalysisMode mode) {
+  ModelAtTreePose model;
+  model.mechanism = std::move(mechanism);
+  Result<AssembledMechanism> assembled =
+      assembleMechanism(model.mechanism, computeTreePoses(model.mechanism, {}), mode);
+  EXPECT_TRUE(isOk(assembled)) << diagnosticOf(assembled).toString();
+  model.assembled = valueOf(std::move(assembled));
+  model.J = computeConstraintJacobian(model.assembled.model, model.assembled.q);
+  return model;
 }
 
 /// A straight chain of @p links revolute joints about z, 0.1 m apart: DOF @p links in the plane and in space.
