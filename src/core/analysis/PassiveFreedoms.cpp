@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <functional>
 #include <limits>
+#include <optional>
 #include <set>
 
 #include <Eigen/Dense>
@@ -56,468 +56,667 @@ bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
   return std::isfinite(inverseNorm) && inverseNorm > 0.0 && std::sqrt(1.0 / inverseNorm) > bound;
 }
 
-}  // namespace
+/// The mechanism at the pose q as the search reads it: the connections that constrain at each link, each
+/// Jacobian row's norm, and the rows of T (the twist of a rigid group mapped onto its coordinates).
+struct SearchContext {
+  SearchContext(const Mechanism& mechanism, const CoordinateModel& model,
+                const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J);
 
-PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const CoordinateModel& model,
-                                    const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J,
-                                    const PassiveFreedomsOptions& options) {
-  PassiveFreedoms result;
-  const int numLinks = static_cast<int>(mechanism.links.size());
-  const int dim = model.dim;
-  const bool planar = dim == 2;
-  const int lambda = model.lambda;
+  /// Element @p e's point or unit vector at q (z = 0 in the plane).
+  Eigen::Vector3d element3(int e) const;
+  /// The row of T for coordinate @p k of element @p e: d(x_k)/d(omega, v), from -[x]x and (points) I; in
+  /// the plane the components omega_z, v_x, v_y.
+  TwistRow twistRow(int e, int k) const;
+  /// The link that connection @p j joins to link @p l.
+  int otherLink(int j, int l) const;
+
+  const Mechanism& mechanism;
+  const CoordinateModel& model;
+  const Eigen::Ref<const Eigen::VectorXd>& q;
+  const SparseJacobian& J;
+  const int numLinks;
+  const int dim;
+  const bool planar;
+  const int lambda;
+  std::vector<std::vector<int>> connectionsAt;  ///< Per link, the connections that constrain it.
+  std::vector<double> rowNorm;                  ///< Per row of J, its norm.
+};
+
+SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& model,
+                             const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J)
+    : mechanism(mechanism),
+      model(model),
+      q(q),
+      J(J),
+      numLinks(static_cast<int>(mechanism.links.size())),
+      dim(model.dim),
+      planar(model.dim == 2),
+      lambda(model.lambda),
+      connectionsAt(static_cast<size_t>(numLinks)),
+      rowNorm(static_cast<size_t>(J.rows())) {
   // Connections that constrain, and the links they join.
   std::vector<int> equationsOf(mechanism.joints.size(), 0);
   for (const ConstraintEquation& eq : model.equations) {
     if (eq.source == EquationSource::Joint)
       ++equationsOf[eq.element];
   }
-  std::vector<std::vector<int>> connectionsAt(numLinks);
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     if (equationsOf[j] == 0)
       continue;
     connectionsAt[mechanism.joints[j].link1].push_back(static_cast<int>(j));
     connectionsAt[mechanism.joints[j].link2].push_back(static_cast<int>(j));
   }
-  const int numCoordinates = model.numCoordinates();
   // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
-  std::vector<double> rowNorm(static_cast<size_t>(J.rows()));
   for (Eigen::Index r = 0; r < J.rows(); ++r)
     rowNorm[static_cast<size_t>(r)] = J.row(r).norm();
-  auto element3 = [&](int e) {
-    const int o = model.elements[e].offset;
-    return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
-  };
-  // The row of T for coordinate k of element e: d(x_k)/d(omega, v), from -[x]x and (points) I; in the plane
-  // the components omega_z, v_x, v_y.
-  auto twistRow = [&](int e, int k) {
-    const int o = model.elements[e].offset;
-    const double point = model.elements[e].isPoint ? 1.0 : 0.0;
-    TwistRow t = TwistRow::Zero();
-    if (planar) {  // omega_z, v_x, v_y of x_k: (-y, 1, 0) and (x, 0, 1) for a point
-      if (k == 0)
-        t.head<3>() << -q(o + 1), point, 0.0;
-      else
-        t.head<3>() << q(o), 0.0, point;
-      return t;
-    }
-    const double x = q(o), y = q(o + 1), z = q(o + 2);
+}
+
+Eigen::Vector3d SearchContext::element3(int e) const {
+  const int o = model.elements[e].offset;
+  return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
+}
+
+TwistRow SearchContext::twistRow(int e, int k) const {
+  const int o = model.elements[e].offset;
+  const double point = model.elements[e].isPoint ? 1.0 : 0.0;
+  TwistRow t = TwistRow::Zero();
+  if (planar) {  // omega_z, v_x, v_y of x_k: (-y, 1, 0) and (x, 0, 1) for a point
     if (k == 0)
-      t << 0.0, z, -y, point, 0.0, 0.0;
-    else if (k == 1)
-      t << -z, 0.0, x, 0.0, point, 0.0;
+      t.head<3>() << -q(o + 1), point, 0.0;
     else
-      t << y, -x, 0.0, 0.0, 0.0, point;
+      t.head<3>() << q(o), 0.0, point;
     return t;
+  }
+  const double x = q(o), y = q(o + 1), z = q(o + 2);
+  if (k == 0)
+    t << 0.0, z, -y, point, 0.0, 0.0;
+  else if (k == 1)
+    t << -z, 0.0, x, 0.0, point, 0.0;
+  else
+    t << y, -x, 0.0, 0.0, 0.0, point;
+  return t;
+}
+
+int SearchContext::otherLink(int j, int l) const {
+  const Joint& joint = mechanism.joints[j];
+  return joint.link1 == l ? joint.link2 : joint.link1;
+}
+
+/// The end-connection bound (PassiveFreedomsOptions, with its proof): per link l, F_l = the sum over the
+/// rows r touching l of |a_{r,l}|^2, where a_{r,l} is row r (scaled to unit norm) on l's columns times T;
+/// and for each of the two connections of a link that may be in a group, the Gram matrix of a_{r,l} over
+/// that connection's rows, valid when each of those rows touches the connection's two links only.
+class EndConnectionBound {
+ public:
+  explicit EndConnectionBound(const SearchContext& context);
+
+  /// Whether the group's two end connections alone prove that no twist of it passes the nullity test of
+  /// the search (PassiveFreedomsOptions): true settles the group with no motion; false decides nothing.
+  bool rigidByEnds(const std::vector<int>& path) const;
+
+ private:
+  static constexpr size_t kLinksPerRow = 4;
+  /// Per coordinate, the element and the link that own it.
+  struct ColumnOwners {
+    std::vector<int> element, link;
+  };
+  /// One row of J, scaled to unit norm, times T, split into its parts a_{r,l} on each link it touches.
+  struct RowParts {
+    std::array<std::pair<int, TwistRow>, kLinksPerRow> perLink;
+    size_t used = 0;
+    bool overflow = false;  ///< The row touches more than kLinksPerRow links.
   };
 
-  // The end-connection bound (PassiveFreedomsOptions, with its proof): per link l, F_l = the sum over the
-  // rows r touching l of |a_{r,l}|^2, where a_{r,l} is row r (scaled to unit norm) on l's columns times T;
-  // and for each of the two connections of a link that may be in a group, the Gram matrix of a_{r,l} over
-  // that connection's rows, valid when each of those rows touches the connection's two links only.
-  const bool bound = options.endConnectionBound;
-  std::vector<double> linkFrobenius;
-  std::vector<double> endGram;  // per link, per connection slot 0 or 1: lambda x lambda
-  std::vector<char> endValid;   // per link and slot
-  const size_t gramSize = static_cast<size_t>(lambda * lambda);
-  if (bound) {
-    std::vector<int> columnElement(static_cast<size_t>(numCoordinates), -1),
-        columnLink(static_cast<size_t>(numCoordinates), -1);
-    for (size_t l = 0; l < model.bodyElements.size(); ++l) {
-      for (int e : model.bodyElements[l]) {
-        for (int k = 0; k < dim; ++k) {
-          columnElement[static_cast<size_t>(model.elements[e].offset + k)] = e;
-          columnLink[static_cast<size_t>(model.elements[e].offset + k)] = static_cast<int>(l);
-        }
-      }
-    }
-    linkFrobenius.assign(static_cast<size_t>(numLinks), 0.0);
-    endGram.assign(static_cast<size_t>(numLinks) * 2 * gramSize, 0.0);
-    endValid.assign(static_cast<size_t>(numLinks) * 2, 1);
-    auto slotOf = [&](int link, int joint) {
-      const std::vector<int>& at = connectionsAt[link];
-      return at.size() != 2 ? -1 : at[0] == joint ? 0 : at[1] == joint ? 1 : -1;
-    };
-    constexpr size_t kLinksPerRow = 4;
-    std::array<std::pair<int, TwistRow>, kLinksPerRow> perLink;
-    for (Eigen::Index r = 0; r < J.rows(); ++r) {
-      size_t used = 0;
-      bool overflow = false;
-      const double norm = rowNorm[static_cast<size_t>(r)];
-      for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
-        const int l = columnLink[static_cast<size_t>(it.col())];
-        size_t slot = 0;
-        while (slot < used && perLink[slot].first != l)
-          ++slot;
-        if (slot == used) {
-          if (used == kLinksPerRow) {  // a row on more than four links: no bound for the links it touches
-            overflow = true;
-            linkFrobenius[static_cast<size_t>(l)] = std::numeric_limits<double>::infinity();
-            continue;
-          }
-          perLink[used++] = {l, TwistRow::Zero()};
-        }
-        const int e = columnElement[static_cast<size_t>(it.col())];
-        perLink[slot].second +=
-            (it.value() / norm) * twistRow(e, static_cast<int>(it.col()) - model.elements[e].offset);
-      }
-      const ConstraintEquation& eq = model.equations[static_cast<size_t>(r)];
-      const Joint* joint = eq.source == EquationSource::Joint ? &mechanism.joints[eq.element] : nullptr;
-      bool twoLinks = joint != nullptr && !overflow;
-      for (size_t s = 0; s < used; ++s)
-        twoLinks = twoLinks && (perLink[s].first == joint->link1 || perLink[s].first == joint->link2);
-      for (size_t s = 0; s < used; ++s) {
-        const int l = perLink[s].first;
-        linkFrobenius[static_cast<size_t>(l)] +=
-            overflow ? std::numeric_limits<double>::infinity() : perLink[s].second.squaredNorm();
-        if (joint == nullptr)
-          continue;
-        const int end = slotOf(l, eq.element);
-        if (end < 0)
-          continue;
-        const size_t at = static_cast<size_t>(l) * 2 + static_cast<size_t>(end);
-        double* gram = &endGram[at * gramSize];
-        const TwistRow& a = perLink[s].second;
-        for (int r1 = 0; r1 < lambda; ++r1) {
-          for (int c1 = 0; c1 < lambda; ++c1)
-            gram[r1 * lambda + c1] += a(r1) * a(c1);
-        }
-      }
-      if (joint != nullptr && !twoLinks) {  // this connection's rows are not all rows of A on the end link
-        for (int l : {joint->link1, joint->link2}) {
-          const int end = slotOf(l, eq.element);
-          if (end >= 0)
-            endValid[static_cast<size_t>(l) * 2 + static_cast<size_t>(end)] = 0;
-        }
+  ColumnOwners findColumnOwners() const;
+  void splitRow(Eigen::Index r, const ColumnOwners& owners, RowParts& parts);
+  void addRow(Eigen::Index r, const RowParts& parts);
+  /// Which of @p link's two connections @p joint is (0 or 1), or -1.
+  int slotOf(int link, int joint) const;
+
+  const SearchContext& context_;
+  const size_t gramSize_;
+  std::vector<double> linkFrobenius_;
+  std::vector<double> endGram_;  // per link, per connection slot 0 or 1: lambda x lambda
+  std::vector<char> endValid_;   // per link and slot
+};
+
+EndConnectionBound::EndConnectionBound(const SearchContext& context)
+    : context_(context), gramSize_(static_cast<size_t>(context.lambda * context.lambda)) {
+  const ColumnOwners owners = findColumnOwners();
+  const size_t numLinks = static_cast<size_t>(context_.numLinks);
+  linkFrobenius_.assign(numLinks, 0.0);
+  endGram_.assign(numLinks * 2 * gramSize_, 0.0);
+  endValid_.assign(numLinks * 2, 1);
+  RowParts parts;
+  for (Eigen::Index r = 0; r < context_.J.rows(); ++r) {
+    splitRow(r, owners, parts);
+    addRow(r, parts);
+  }
+}
+
+EndConnectionBound::ColumnOwners EndConnectionBound::findColumnOwners() const {
+  const CoordinateModel& model = context_.model;
+  const size_t numCoordinates = static_cast<size_t>(model.numCoordinates());
+  ColumnOwners owners{std::vector<int>(numCoordinates, -1), std::vector<int>(numCoordinates, -1)};
+  for (size_t l = 0; l < model.bodyElements.size(); ++l) {
+    for (int e : model.bodyElements[l]) {
+      for (int k = 0; k < context_.dim; ++k) {
+        owners.element[static_cast<size_t>(model.elements[e].offset + k)] = e;
+        owners.link[static_cast<size_t>(model.elements[e].offset + k)] = static_cast<int>(l);
       }
     }
   }
-  // Whether the group's two end connections alone prove that no twist of it passes the nullity test of the
-  // search (PassiveFreedomsOptions): true settles the group with no motion; false decides nothing.
-  auto rigidByEnds = [&](const std::vector<int>& path) {
-    Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
-    double frobenius2 = 0.0;
-    int ends = 0;
-    for (int l : path) {
-      frobenius2 += linkFrobenius[static_cast<size_t>(l)];
-      for (size_t s = 0; s < 2; ++s) {
-        const Joint& joint = mechanism.joints[connectionsAt[l][s]];
-        const int other = joint.link1 == l ? joint.link2 : joint.link1;
-        if (std::find(path.begin(), path.end(), other) != path.end())
-          continue;
-        const size_t at = static_cast<size_t>(l) * 2 + s;
-        if (!endValid[at])
-          return false;
-        ++ends;
-        const double* end = &endGram[at * gramSize];
-        for (int r1 = 0; r1 < lambda; ++r1) {
-          for (int c1 = 0; c1 < lambda; ++c1)
-            gram(r1, c1) += end[r1 * lambda + c1];
-        }
+  return owners;
+}
+
+void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, RowParts& parts) {
+  parts.used = 0;
+  parts.overflow = false;
+  const double norm = context_.rowNorm[static_cast<size_t>(r)];
+  for (SparseJacobian::InnerIterator it(context_.J, r); it; ++it) {
+    const int l = owners.link[static_cast<size_t>(it.col())];
+    size_t slot = 0;
+    while (slot < parts.used && parts.perLink[slot].first != l)
+      ++slot;
+    if (slot == parts.used) {
+      if (parts.used == kLinksPerRow) {  // a row on more than four links: no bound for the links it touches
+        parts.overflow = true;
+        linkFrobenius_[static_cast<size_t>(l)] = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      parts.perLink[parts.used++] = {l, TwistRow::Zero()};
+    }
+    const int e = owners.element[static_cast<size_t>(it.col())];
+    const int k = static_cast<int>(it.col()) - context_.model.elements[e].offset;
+    parts.perLink[slot].second += (it.value() / norm) * context_.twistRow(e, k);
+  }
+}
+
+void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
+  const int lambda = context_.lambda;
+  const ConstraintEquation& eq = context_.model.equations[static_cast<size_t>(r)];
+  const Joint* joint = eq.source == EquationSource::Joint ? &context_.mechanism.joints[eq.element] : nullptr;
+  bool twoLinks = joint != nullptr && !parts.overflow;
+  for (size_t s = 0; s < parts.used; ++s)
+    twoLinks = twoLinks && (parts.perLink[s].first == joint->link1 || parts.perLink[s].first == joint->link2);
+  for (size_t s = 0; s < parts.used; ++s) {
+    const int l = parts.perLink[s].first;
+    linkFrobenius_[static_cast<size_t>(l)] +=
+        parts.overflow ? std::numeric_limits<double>::infinity() : parts.perLink[s].second.squaredNorm();
+    if (joint == nullptr)
+      continue;
+    const int end = slotOf(l, eq.element);
+    if (end < 0)
+      continue;
+    const size_t at = static_cast<size_t>(l) * 2 + static_cast<size_t>(end);
+    double* gram = &endGram_[at * gramSize_];
+    const TwistRow& a = parts.perLink[s].second;
+    for (int r1 = 0; r1 < lambda; ++r1) {
+      for (int c1 = 0; c1 < lambda; ++c1)
+        gram[r1 * lambda + c1] += a(r1) * a(c1);
+    }
+  }
+  if (joint != nullptr && !twoLinks) {  // this connection's rows are not all rows of A on the end link
+    for (int l : {joint->link1, joint->link2}) {
+      const int end = slotOf(l, eq.element);
+      if (end >= 0)
+        endValid_[static_cast<size_t>(l) * 2 + static_cast<size_t>(end)] = 0;
+    }
+  }
+}
+
+int EndConnectionBound::slotOf(int link, int joint) const {
+  const std::vector<int>& at = context_.connectionsAt[link];
+  return at.size() != 2 ? -1 : at[0] == joint ? 0 : at[1] == joint ? 1 : -1;
+}
+
+bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
+  const int lambda = context_.lambda;
+  Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+  double frobenius2 = 0.0;
+  int ends = 0;
+  for (int l : path) {
+    frobenius2 += linkFrobenius_[static_cast<size_t>(l)];
+    for (size_t s = 0; s < 2; ++s) {
+      const int other = context_.otherLink(context_.connectionsAt[l][s], l);
+      if (std::find(path.begin(), path.end(), other) != path.end())
+        continue;
+      const size_t at = static_cast<size_t>(l) * 2 + s;
+      if (!endValid_[at])
+        return false;
+      ++ends;
+      const double* end = &endGram_[at * gramSize_];
+      for (int r1 = 0; r1 < lambda; ++r1) {
+        for (int c1 = 0; c1 < lambda; ++c1)
+          gram(r1, c1) += end[r1 * lambda + c1];
       }
     }
-    frobenius2 *= static_cast<double>(path.size());
-    if (ends != 2 || !std::isfinite(frobenius2))
-      return false;
-    const double limit = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
-    return planar ? clearlyFullRank<3>(gram, limit) : clearlyFullRank<6>(gram, limit);
-  };
+  }
+  frobenius2 *= static_cast<double>(path.size());
+  if (ends != 2 || !std::isfinite(frobenius2))
+    return false;
+  const double limit = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
+  return context_.planar ? clearlyFullRank<3>(gram, limit) : clearlyFullRank<6>(gram, limit);
+}
 
-  // Candidate groups: every link with two connections but the ground, and chains of such links. Each group's
-  // links sorted and padded with -1, so that the groups sort (and are taken) as sorted vectors would. A group
-  // the end-connection bound settles has no motion and is not kept (the order of the others is unchanged).
-  using Group = std::array<int, kMaxGroup>;
-  std::vector<Group> groups;
-  auto addGroup = [&](const std::vector<int>& path) {
-    if (path.front() > path.back())
-      return;  // the same links are met from the other end, as the reversed path
-    if (bound && rigidByEnds(path)) {
-      ++result.groupsRigidByEnds;
-      return;
-    }
-    Group group;
-    group.fill(-1);
-    for (size_t i = 0; i < path.size(); ++i) {  // insertion sort of at most kMaxGroup links
-      size_t k = i;
-      for (; k > 0 && group[k - 1] > path[i]; --k)
-        group[k] = group[k - 1];
-      group[k] = path[i];
-    }
-    groups.push_back(group);
-  };
+/// A candidate group's links, sorted and padded with -1, so that the groups sort (and are taken) as sorted
+/// vectors would.
+using Group = std::array<int, kMaxGroup>;
+
+struct CandidateGroups {
+  std::vector<Group> groups;  ///< Sorted, each once.
+  int rigidByEnds = 0;        ///< Groups the end-connection bound settled (not in groups).
+};
+
+/// Adds the chain @p path as a group, unless it is the reverse of a chain met already or @p bound (when
+/// given) settles it.
+void addGroup(const std::vector<int>& path, const EndConnectionBound* bound, CandidateGroups& candidates) {
+  if (path.front() > path.back())
+    return;  // the same links are met from the other end, as the reversed path
+  if (bound != nullptr && bound->rigidByEnds(path)) {
+    ++candidates.rigidByEnds;
+    return;
+  }
+  Group group;
+  group.fill(-1);
+  for (size_t i = 0; i < path.size(); ++i) {  // insertion sort of at most kMaxGroup links
+    size_t k = i;
+    for (; k > 0 && group[k - 1] > path[i]; --k)
+      group[k] = group[k - 1];
+    group[k] = path[i];
+  }
+  candidates.groups.push_back(group);
+}
+
+/// Adds every chain that continues @p path by links with two connections, up to kMaxGroup links.
+void extendChain(const SearchContext& context, std::vector<int>& path, const EndConnectionBound* bound,
+                 CandidateGroups& candidates) {
+  if (path.size() >= kMaxGroup)
+    return;
+  const int last = path.back();
+  if (context.connectionsAt[last].size() != 2)
+    return;
+  for (int j : context.connectionsAt[last]) {
+    const int next = context.otherLink(j, last);
+    if (next == context.mechanism.rootLink || context.connectionsAt[next].size() != 2 ||
+        std::find(path.begin(), path.end(), next) != path.end())
+      continue;
+    path.push_back(next);
+    addGroup(path, bound, candidates);
+    extendChain(context, path, bound, candidates);
+    path.pop_back();
+  }
+}
+
+/// Candidate groups: every link with two connections but the ground, and chains of such links. A group the
+/// end-connection bound settles has no motion and is not kept (the order of the others is unchanged).
+CandidateGroups findCandidateGroups(const SearchContext& context, const EndConnectionBound* bound) {
+  CandidateGroups candidates;
   std::vector<int> chain;
-  std::function<void(std::vector<int>&)> extend = [&](std::vector<int>& path) {
-    if (path.size() >= kMaxGroup)
-      return;
-    const int last = path.back();
-    if (connectionsAt[last].size() != 2)
-      return;
-    for (int j : connectionsAt[last]) {
-      const Joint& joint = mechanism.joints[j];
-      const int next = joint.link1 == last ? joint.link2 : joint.link1;
-      if (next == mechanism.rootLink || connectionsAt[next].size() != 2 ||
-          std::find(path.begin(), path.end(), next) != path.end())
-        continue;
-      path.push_back(next);
-      addGroup(path);
-      extend(path);
-      path.pop_back();
-    }
-  };
-  for (int l = 0; l < numLinks; ++l) {
-    if (l == mechanism.rootLink || connectionsAt[l].size() != 2)
+  for (int l = 0; l < context.numLinks; ++l) {
+    if (l == context.mechanism.rootLink || context.connectionsAt[l].size() != 2)
       continue;
     chain.assign(1, l);
-    addGroup(chain);
-    extend(chain);
+    addGroup(chain, bound, candidates);
+    extendChain(context, chain, bound, candidates);
   }
+  std::vector<Group>& groups = candidates.groups;
   std::sort(groups.begin(), groups.end());
   groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
-  if (groups.empty())
-    return result;
+  return candidates;
+}
 
+/// The search of the candidate groups, in their order: a group's null twists, the finite check of each, and
+/// the comparison with the motions kept so far.
+class GroupSearch {
+ public:
+  explicit GroupSearch(const SearchContext& context);
+
+  /// Searches the group @p padded: counts it in @p result if it qualifies and appends its new motions.
+  void search(const Group& padded, PassiveFreedoms& result);
+
+ private:
+  /// A motion as (coordinate, value) over its group's coordinates.
+  using Motion = std::vector<std::pair<int, double>>;
+
+  void searchMarked(PassiveFreedoms& result);
+  bool hasTwoEndsToTwoLinks();
+  void collectColumnsAndRows();
+  bool boundsClearNullity() const;
+  Eigen::MatrixXd buildT() const;
+  Eigen::MatrixXd buildA(const Eigen::MatrixXd& T) const;
+  void clearLocalColumns();
+  void searchNullTwists(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A, PassiveFreedoms& result);
+  bool movesFinitely(const Eigen::Vector3d& omega, const Eigen::Vector3d& v);
+  bool isIndependent(const Motion& motion);
+  void accept(Motion motion);
+  PassiveMotion describe(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) const;
+  std::string endsPhrase() const;
+
+  const SearchContext& context_;
   // Column access, made when a group first needs it (none does on a serial chain).
-  Eigen::SparseMatrix<double> Jc;
-  bool haveColumns = false;
-  std::vector<char> inGroup(numLinks, 0);
-
-  // Motions kept, each as (coordinate, value) over its group's coordinates, and the motions at each link: a
-  // group is compared with those sharing one of its links only, and nothing here costs more than the group's
-  // neighbourhood (a chain of 10^5 links has 3 10^5 candidate groups).
-  std::vector<std::vector<std::pair<int, double>>> accepted;
-  std::vector<std::vector<int>> acceptedAt(numLinks);
-  std::vector<int> localColumn(model.numCoordinates(), -1);
-  Eigen::VectorXd moved;  // q, copied when a first twist is stepped
+  Eigen::SparseMatrix<double> Jc_;
+  bool haveColumns_ = false;
+  std::vector<char> inGroup_;
+  // Motions kept, and the motions at each link: a group is compared with those sharing one of its links
+  // only, and nothing here costs more than the group's neighbourhood (a chain of 10^5 links has 3 10^5
+  // candidate groups).
+  std::vector<Motion> accepted_;
+  std::vector<std::vector<int>> acceptedAt_;
+  std::vector<int> localColumn_;
+  Eigen::VectorXd moved_;  // q, copied when a first twist is stepped
   // Work space of one group, reused (a chain of 10^5 links has 3 10^5 groups: no allocation per group).
-  std::vector<int> group, outside, elements, columns, rows;
-  std::vector<TwistRow> twistRows;  // the rows of T below (lambda entries, zero beyond)
-  for (const Group& padded : groups) {
-    group.assign(padded.begin(), std::find(padded.begin(), padded.end(), -1));
-    for (int l : group)
-      inGroup[l] = 1;
-    struct Reset {  // inGroup back to all zero however this group's iteration ends
-      std::vector<char>& flags;
-      const std::vector<int>& links;
-      ~Reset() {
-        for (int l : links)
-          flags[l] = 0;
-      }
-    } reset{inGroup, group};
-    // T: coordinates of the group's elements per twist component (space: omega, v; plane: omega_z, v_x, v_y).
-    // Its end connections must reach at least two other links: a link turning on connections to one link
-    // only (a door on its hinges, a robot's last link) is that link's output, not an idle motion.
-    outside.clear();
-    for (int l : group) {
-      for (int j : connectionsAt[l]) {
-        const Joint& joint = mechanism.joints[j];
-        if (!inGroup[joint.link1])
-          outside.push_back(joint.link1);
-        if (!inGroup[joint.link2])
-          outside.push_back(joint.link2);
-      }
-    }
-    std::sort(outside.begin(), outside.end());
-    outside.erase(std::unique(outside.begin(), outside.end()), outside.end());
-    int ends = 0;
-    for (int l : group) {
-      for (int j : connectionsAt[l])
-        ends += inGroup[mechanism.joints[j].link1] && inGroup[mechanism.joints[j].link2] ? 0 : 1;
-    }
-    if (outside.size() < 2 || ends != 2)
-      continue;
-    ++result.groupsSearched;
-    elements.clear();
-    for (int l : group)
-      elements.insert(elements.end(), model.bodyElements[l].begin(), model.bodyElements[l].end());
-    columns.clear();
-    twistRows.clear();
-    for (int e : elements) {
-      for (int k = 0; k < dim; ++k) {
-        columns.push_back(model.elements[e].offset + k);
-        twistRows.push_back(twistRow(e, k));
-      }
-    }
-    // A = J(rows touching the group, group columns) T, rows scaled to unit norm.
-    rows.clear();
-    if (!haveColumns) {
-      Jc = J;
-      haveColumns = true;
-    }
-    for (int c : columns) {
-      for (Eigen::SparseMatrix<double>::InnerIterator it(Jc, c); it; ++it)
-        rows.push_back(static_cast<int>(it.row()));
-    }
-    std::sort(rows.begin(), rows.end());
-    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-    for (size_t c = 0; c < columns.size(); ++c)
-      localColumn[columns[c]] = static_cast<int>(c);
-    // Most groups (every link of a serial chain) have no null twist at all. sigma_min(A)^2 is at least
-    // 1 / |(A^T A)^-1|_F and sigma_max(A) at most |A|_F: when these bounds clear the nullity test a
-    // hundredfold (far beyond what rounding in A^T A can move them), no twist can pass it and the SVD is
-    // skipped; otherwise it decides exactly as before. A^T A is summed row by row in fixed-size storage (at
-    // most 6 x 6), A itself is built only for the SVD.
-    if (static_cast<int>(rows.size()) >= lambda) {
-      Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
-      double frobenius2 = 0.0;
-      TwistRow a;
-      for (int r : rows) {
-        a.setZero();
-        const double norm = rowNorm[static_cast<size_t>(r)];
-        for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
-          const int c = localColumn[it.col()];
-          if (c >= 0)
-            a += (it.value() / norm) * twistRows[static_cast<size_t>(c)];
-        }
-        gram.noalias() += a.transpose() * a;
-        frobenius2 += a.squaredNorm();
-      }
-      const double bound = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
-      if (planar ? clearlyFullRank<3>(gram, bound) : clearlyFullRank<6>(gram, bound)) {
-        for (int c : columns)
-          localColumn[c] = -1;
-        continue;
-      }
-    }
-    Eigen::MatrixXd T(static_cast<Eigen::Index>(twistRows.size()), lambda);
-    for (size_t c = 0; c < twistRows.size(); ++c)
-      T.row(static_cast<Eigen::Index>(c)) = twistRows[c].head(lambda);
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), lambda);
-    for (size_t r = 0; r < rows.size(); ++r) {
-      const double norm = rowNorm[static_cast<size_t>(rows[r])];
-      for (SparseJacobian::InnerIterator it(J, rows[r]); it; ++it) {
-        const int c = localColumn[it.col()];
-        if (c >= 0)
-          A.row(static_cast<Eigen::Index>(r)) += (it.value() / norm) * T.row(c);
-      }
-    }
-    for (int c : columns)
-      localColumn[c] = -1;
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
-    const Eigen::VectorXd sigma = svd.singularValues();
-    const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
-    for (int k = 0; k < lambda; ++k) {
-      if (k < sigma.size() && sigma(k) > kTwistNullity * std::max(largest, 1.0))
-        continue;
-      Eigen::VectorXd xi = svd.matrixV().col(k);
-      Eigen::Vector3d omega, v;
-      if (planar) {
-        omega = Eigen::Vector3d(0.0, 0.0, xi(0));
-        v = Eigen::Vector3d(xi(1), xi(2), 0.0);
-      } else {
-        omega = xi.head<3>();
-        v = xi.tail<3>();
-      }
-      // Finite: the group moved by exp(step xi) keeps every constraint.
-      const double scale = kFiniteStep / std::max(omega.norm(), v.norm());
-      const Eigen::Isometry3d g = exponential(scale * omega, scale * v);
-      // (moved is q outside the group: one copy for all groups, put back after each.)
-      if (moved.size() == 0)
-        moved = q;
-      for (int e : elements) {
-        const Eigen::Vector3d x = element3(e);
-        const Eigen::Vector3d y = model.elements[e].isPoint ? (g * x).eval() : (g.linear() * x).eval();
-        moved.segment(model.elements[e].offset, dim) = y.head(dim);
-      }
-      // Only the rows touching the group can change.
-      const ElementView before(model, q), after(model, moved);
-      double change = 0.0;
-      for (int r : rows) {
-        const ConstraintEquation& eq = model.equations[r];
-        change = std::max(change, std::abs(visitForm(eq.form, [&](auto form) {
-                            return form.value(after, eq) - form.value(before, eq);
-                          })));
-      }
-      for (int e : elements)
-        moved.segment(model.elements[e].offset, dim) = q.segment(model.elements[e].offset, dim);
-      if (change > kFiniteResidual)
-        continue;
-      // Independent of the motions already kept (only those sharing a link can be dependent), compared over
-      // the coordinates they move (every other coordinate is zero in all of them).
-      std::vector<std::pair<int, double>> motion;
-      const Eigen::VectorXd local = T * xi;
-      for (size_t c = 0; c < columns.size(); ++c)
-        motion.emplace_back(columns[c], local(static_cast<Eigen::Index>(c)));
-      std::vector<int> overlapping;
-      for (int l : group) {
-        for (int a : acceptedAt[l]) {
-          if (std::find(overlapping.begin(), overlapping.end(), a) == overlapping.end())
-            overlapping.push_back(a);
-        }
-      }
-      std::sort(overlapping.begin(), overlapping.end());
-      if (!overlapping.empty()) {
-        std::vector<int> support;
-        auto columnOf = [&](int coordinate) {
-          if (localColumn[coordinate] < 0) {
-            localColumn[coordinate] = static_cast<int>(support.size());
-            support.push_back(coordinate);
-          }
-          return localColumn[coordinate];
-        };
-        for (int a : overlapping) {
-          for (const auto& entry : accepted[a])
-            columnOf(entry.first);
-        }
-        for (const auto& entry : motion)
-          columnOf(entry.first);
-        Eigen::MatrixXd stack = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(support.size()),
-                                                      static_cast<Eigen::Index>(overlapping.size()) + 1);
-        auto fill = [&](const std::vector<std::pair<int, double>>& vector, Eigen::Index column) {
-          for (const auto& [coordinate, value] : vector)
-            stack(localColumn[coordinate], column) = value;
-          stack.col(column).normalize();
-        };
-        for (size_t a = 0; a < overlapping.size(); ++a)
-          fill(accepted[overlapping[a]], static_cast<Eigen::Index>(a));
-        fill(motion, stack.cols() - 1);
-        for (int coordinate : support)
-          localColumn[coordinate] = -1;
-        Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(stack);
-        qr.setThreshold(1e-6);
-        if (qr.rank() < stack.cols())
-          continue;
-      }
-      for (int l : group)
-        acceptedAt[l].push_back(static_cast<int>(accepted.size()));
-      accepted.push_back(std::move(motion));
-      // The phrase: the group, what it does, and the connections it turns or slides between.
-      PassiveMotion passive;
-      std::string names;
-      for (int l : group) {
-        passive.links.push_back(mechanism.links[l].name);
-        names += (names.empty() ? "" : "-") + mechanism.links[l].name;
-      }
-      std::vector<int> ends;
-      std::set<std::string> types;
-      for (int l : group) {
-        for (int j : connectionsAt[l]) {
-          const Joint& joint = mechanism.joints[j];
-          if (inGroup[joint.link1] && inGroup[joint.link2])
-            continue;
-          ends.push_back(j);
-          types.insert(joint.kind == ConnectionKind::DistanceConstraint ? "distance" : toString(joint.type));
-        }
-      }
-      std::string endText;
-      for (size_t i = 0; i < ends.size(); ++i)
-        endText += (i == 0 ? "" : (i + 1 == ends.size() ? " and " : ", ")) + mechanism.joints[ends[i]].name;
-      const std::string jointWord =
-          types.size() == 1 && *types.begin() == "spherical"   ? "ball joints"
-          : types.size() == 1 && *types.begin() == "prismatic" ? "prismatic joints"
-          : types.size() == 1 && (*types.begin() == "revolute" || *types.begin() == "continuous")
-              ? "revolute joints"
-              : "joints";
-      const std::string subject = (group.size() == 1 ? "link " : "chain ") + names;
-      if (omega.norm() < 1e-9 * v.norm()) {
-        passive.description = subject + " slides along the line of its " + jointWord + " " + endText;
-      } else if (std::abs(omega.normalized().dot(v)) > 1e-6 * v.norm() + 1e-12) {
-        passive.description = subject + " screws about the line of its " + jointWord + " " + endText;
-      } else {
-        passive.description = subject + " spins about the line through its " + jointWord + " " + endText;
-      }
-      result.motions.push_back(std::move(passive));
+  std::vector<int> group_, outside_, elements_, columns_, rows_;
+  std::vector<TwistRow> twistRows_;  // the rows of T (lambda entries, zero beyond)
+};
+
+GroupSearch::GroupSearch(const SearchContext& context)
+    : context_(context),
+      inGroup_(context.numLinks, 0),
+      acceptedAt_(context.numLinks),
+      localColumn_(context.model.numCoordinates(), -1) {}
+
+void GroupSearch::search(const Group& padded, PassiveFreedoms& result) {
+  group_.assign(padded.begin(), std::find(padded.begin(), padded.end(), -1));
+  for (int l : group_)
+    inGroup_[l] = 1;
+  searchMarked(result);
+  for (int l : group_)  // inGroup_ back to all zero
+    inGroup_[l] = 0;
+}
+
+void GroupSearch::searchMarked(PassiveFreedoms& result) {
+  if (!hasTwoEndsToTwoLinks())
+    return;
+  ++result.groupsSearched;
+  collectColumnsAndRows();
+  if (static_cast<int>(rows_.size()) >= context_.lambda && boundsClearNullity()) {
+    clearLocalColumns();
+    return;
+  }
+  const Eigen::MatrixXd T = buildT();
+  const Eigen::MatrixXd A = buildA(T);
+  clearLocalColumns();
+  searchNullTwists(T, A, result);
+}
+
+/// The group's end connections must reach at least two other links: a link turning on connections to one
+/// link only (a door on its hinges, a robot's last link) is that link's output, not an idle motion.
+bool GroupSearch::hasTwoEndsToTwoLinks() {
+  const Mechanism& mechanism = context_.mechanism;
+  outside_.clear();
+  for (int l : group_) {
+    for (int j : context_.connectionsAt[l]) {
+      const Joint& joint = mechanism.joints[j];
+      if (!inGroup_[joint.link1])
+        outside_.push_back(joint.link1);
+      if (!inGroup_[joint.link2])
+        outside_.push_back(joint.link2);
     }
   }
+  std::sort(outside_.begin(), outside_.end());
+  outside_.erase(std::unique(outside_.begin(), outside_.end()), outside_.end());
+  int ends = 0;
+  for (int l : group_) {
+    for (int j : context_.connectionsAt[l])
+      ends += inGroup_[mechanism.joints[j].link1] && inGroup_[mechanism.joints[j].link2] ? 0 : 1;
+  }
+  return outside_.size() >= 2 && ends == 2;
+}
+
+/// T: coordinates of the group's elements per twist component (space: omega, v; plane: omega_z, v_x, v_y),
+/// the rows of J that touch them, and localColumn_ set to each group coordinate's row of T.
+void GroupSearch::collectColumnsAndRows() {
+  const CoordinateModel& model = context_.model;
+  elements_.clear();
+  for (int l : group_)
+    elements_.insert(elements_.end(), model.bodyElements[l].begin(), model.bodyElements[l].end());
+  columns_.clear();
+  twistRows_.clear();
+  for (int e : elements_) {
+    for (int k = 0; k < context_.dim; ++k) {
+      columns_.push_back(model.elements[e].offset + k);
+      twistRows_.push_back(context_.twistRow(e, k));
+    }
+  }
+  rows_.clear();
+  if (!haveColumns_) {
+    Jc_ = context_.J;
+    haveColumns_ = true;
+  }
+  for (int c : columns_) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(Jc_, c); it; ++it)
+      rows_.push_back(static_cast<int>(it.row()));
+  }
+  std::sort(rows_.begin(), rows_.end());
+  rows_.erase(std::unique(rows_.begin(), rows_.end()), rows_.end());
+  for (size_t c = 0; c < columns_.size(); ++c)
+    localColumn_[columns_[c]] = static_cast<int>(c);
+}
+
+/// Most groups (every link of a serial chain) have no null twist at all. sigma_min(A)^2 is at least
+/// 1 / |(A^T A)^-1|_F and sigma_max(A) at most |A|_F: when these bounds clear the nullity test a
+/// hundredfold (far beyond what rounding in A^T A can move them), no twist can pass it and the SVD is
+/// skipped; otherwise it decides exactly as before. A^T A is summed row by row in fixed-size storage (at
+/// most 6 x 6), A itself is built only for the SVD.
+bool GroupSearch::boundsClearNullity() const {
+  Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+  double frobenius2 = 0.0;
+  TwistRow a;
+  for (int r : rows_) {
+    a.setZero();
+    const double norm = context_.rowNorm[static_cast<size_t>(r)];
+    for (SparseJacobian::InnerIterator it(context_.J, r); it; ++it) {
+      const int c = localColumn_[it.col()];
+      if (c >= 0)
+        a += (it.value() / norm) * twistRows_[static_cast<size_t>(c)];
+    }
+    gram.noalias() += a.transpose() * a;
+    frobenius2 += a.squaredNorm();
+  }
+  const double bound = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
+  return context_.planar ? clearlyFullRank<3>(gram, bound) : clearlyFullRank<6>(gram, bound);
+}
+
+Eigen::MatrixXd GroupSearch::buildT() const {
+  Eigen::MatrixXd T(static_cast<Eigen::Index>(twistRows_.size()), context_.lambda);
+  for (size_t c = 0; c < twistRows_.size(); ++c)
+    T.row(static_cast<Eigen::Index>(c)) = twistRows_[c].head(context_.lambda);
+  return T;
+}
+
+/// A = J(rows touching the group, group columns) T, rows scaled to unit norm.
+Eigen::MatrixXd GroupSearch::buildA(const Eigen::MatrixXd& T) const {
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows_.size()), context_.lambda);
+  for (size_t r = 0; r < rows_.size(); ++r) {
+    const double norm = context_.rowNorm[static_cast<size_t>(rows_[r])];
+    for (SparseJacobian::InnerIterator it(context_.J, rows_[r]); it; ++it) {
+      const int c = localColumn_[it.col()];
+      if (c >= 0)
+        A.row(static_cast<Eigen::Index>(r)) += (it.value() / norm) * T.row(c);
+    }
+  }
+  return A;
+}
+
+void GroupSearch::clearLocalColumns() {
+  for (int c : columns_)
+    localColumn_[c] = -1;
+}
+
+/// Each twist xi that A (nearly) annihilates is a motion when it is also finite and independent of the
+/// motions kept so far.
+void GroupSearch::searchNullTwists(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A,
+                                   PassiveFreedoms& result) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  const Eigen::VectorXd sigma = svd.singularValues();
+  const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
+  for (int k = 0; k < context_.lambda; ++k) {
+    if (k < sigma.size() && sigma(k) > kTwistNullity * std::max(largest, 1.0))
+      continue;
+    Eigen::VectorXd xi = svd.matrixV().col(k);
+    Eigen::Vector3d omega, v;
+    if (context_.planar) {
+      omega = Eigen::Vector3d(0.0, 0.0, xi(0));
+      v = Eigen::Vector3d(xi(1), xi(2), 0.0);
+    } else {
+      omega = xi.head<3>();
+      v = xi.tail<3>();
+    }
+    if (!movesFinitely(omega, v))
+      continue;
+    Motion motion;
+    const Eigen::VectorXd local = T * xi;
+    for (size_t c = 0; c < columns_.size(); ++c)
+      motion.emplace_back(columns_[c], local(static_cast<Eigen::Index>(c)));
+    if (!isIndependent(motion))
+      continue;
+    accept(std::move(motion));
+    result.motions.push_back(describe(omega, v));
+  }
+}
+
+/// Finite: the group moved by exp(step xi) keeps every constraint.
+bool GroupSearch::movesFinitely(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) {
+  const CoordinateModel& model = context_.model;
+  const int dim = context_.dim;
+  const double scale = kFiniteStep / std::max(omega.norm(), v.norm());
+  const Eigen::Isometry3d g = exponential(scale * omega, scale * v);
+  // (moved_ is q outside the group: one copy for all groups, put back after each.)
+  if (moved_.size() == 0)
+    moved_ = context_.q;
+  for (int e : elements_) {
+    const Eigen::Vector3d x = context_.element3(e);
+    const Eigen::Vector3d y = model.elements[e].isPoint ? (g * x).eval() : (g.linear() * x).eval();
+    moved_.segment(model.elements[e].offset, dim) = y.head(dim);
+  }
+  // Only the rows touching the group can change.
+  const ElementView before(model, context_.q), after(model, moved_);
+  double change = 0.0;
+  for (int r : rows_) {
+    const ConstraintEquation& eq = model.equations[r];
+    change = std::max(change, std::abs(visitForm(eq.form, [&](auto form) {
+                        return form.value(after, eq) - form.value(before, eq);
+                      })));
+  }
+  for (int e : elements_)
+    moved_.segment(model.elements[e].offset, dim) = context_.q.segment(model.elements[e].offset, dim);
+  return !(change > kFiniteResidual);
+}
+
+/// Independent of the motions already kept (only those sharing a link can be dependent), compared over the
+/// coordinates they move (every other coordinate is zero in all of them).
+bool GroupSearch::isIndependent(const Motion& motion) {
+  std::vector<int> overlapping;
+  for (int l : group_) {
+    for (int a : acceptedAt_[l]) {
+      if (std::find(overlapping.begin(), overlapping.end(), a) == overlapping.end())
+        overlapping.push_back(a);
+    }
+  }
+  std::sort(overlapping.begin(), overlapping.end());
+  if (overlapping.empty())
+    return true;
+  std::vector<int> support;
+  auto columnOf = [&](int coordinate) {
+    if (localColumn_[coordinate] < 0) {
+      localColumn_[coordinate] = static_cast<int>(support.size());
+      support.push_back(coordinate);
+    }
+    return localColumn_[coordinate];
+  };
+  for (int a : overlapping) {
+    for (const auto& entry : accepted_[a])
+      columnOf(entry.first);
+  }
+  for (const auto& entry : motion)
+    columnOf(entry.first);
+  Eigen::MatrixXd stack = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(support.size()),
+                                                static_cast<Eigen::Index>(overlapping.size()) + 1);
+  auto fill = [&](const Motion& vector, Eigen::Index column) {
+    for (const auto& [coordinate, value] : vector)
+      stack(localColumn_[coordinate], column) = value;
+    stack.col(column).normalize();
+  };
+  for (size_t a = 0; a < overlapping.size(); ++a)
+    fill(accepted_[overlapping[a]], static_cast<Eigen::Index>(a));
+  fill(motion, stack.cols() - 1);
+  for (int coordinate : support)
+    localColumn_[coordinate] = -1;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(stack);
+  qr.setThreshold(1e-6);
+  return qr.rank() >= stack.cols();
+}
+
+void GroupSearch::accept(Motion motion) {
+  for (int l : group_)
+    acceptedAt_[l].push_back(static_cast<int>(accepted_.size()));
+  accepted_.push_back(std::move(motion));
+}
+
+/// The phrase: the group, what it does, and the connections it turns or slides between.
+PassiveMotion GroupSearch::describe(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) const {
+  PassiveMotion passive;
+  std::string names;
+  for (int l : group_) {
+    passive.links.push_back(context_.mechanism.links[l].name);
+    names += (names.empty() ? "" : "-") + context_.mechanism.links[l].name;
+  }
+  const std::string ends = endsPhrase();
+  const std::string subject = (group_.size() == 1 ? "link " : "chain ") + names;
+  if (omega.norm() < 1e-9 * v.norm()) {
+    passive.description = subject + " slides along the line of its " + ends;
+  } else if (std::abs(omega.normalized().dot(v)) > 1e-6 * v.norm() + 1e-12) {
+    passive.description = subject + " screws about the line of its " + ends;
+  } else {
+    passive.description = subject + " spins about the line through its " + ends;
+  }
+  return passive;
+}
+
+/// The group's end connections, "revolute joints j1 and j2" (their kind named when they share one).
+std::string GroupSearch::endsPhrase() const {
+  const Mechanism& mechanism = context_.mechanism;
+  std::vector<int> ends;
+  std::set<std::string> types;
+  for (int l : group_) {
+    for (int j : context_.connectionsAt[l]) {
+      const Joint& joint = mechanism.joints[j];
+      if (inGroup_[joint.link1] && inGroup_[joint.link2])
+        continue;
+      ends.push_back(j);
+      types.insert(joint.kind == ConnectionKind::DistanceConstraint ? "distance" : toString(joint.type));
+    }
+  }
+  std::string endText;
+  for (size_t i = 0; i < ends.size(); ++i)
+    endText += (i == 0 ? "" : (i + 1 == ends.size() ? " and " : ", ")) + mechanism.joints[ends[i]].name;
+  const std::string jointWord =
+      types.size() == 1 && *types.begin() == "spherical"   ? "ball joints"
+      : types.size() == 1 && *types.begin() == "prismatic" ? "prismatic joints"
+      : types.size() == 1 && (*types.begin() == "revolute" || *types.begin() == "continuous")
+          ? "revolute joints"
+          : "joints";
+  return jointWord + " " + endText;
+}
+
+}  // namespace
+
+PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const CoordinateModel& model,
+                                    const Eigen::Ref<const Eigen::VectorXd>& q, const SparseJacobian& J,
+                                    const PassiveFreedomsOptions& options) {
+  PassiveFreedoms result;
+  const SearchContext context(mechanism, model, q, J);
+  std::optional<EndConnectionBound> bound;
+  if (options.endConnectionBound)
+    bound.emplace(context);
+  const CandidateGroups candidates = findCandidateGroups(context, bound ? &*bound : nullptr);
+  result.groupsRigidByEnds = candidates.rigidByEnds;
+  if (candidates.groups.empty())
+    return result;
+  GroupSearch search(context);
+  for (const Group& group : candidates.groups)
+    search.search(group, result);
   result.dof = static_cast<int>(result.motions.size());
   return result;
 }
