@@ -68,7 +68,8 @@ using ProgressCallback = std::function<void(double)>;
  * @param[in] tolerance relative rank threshold.
  * @param[in] progress called with the fraction of equations swept.
  * @param[in] fillBudget entries the sweep from the ground may store before it is abandoned for the
- * leaves-first order (0: 8 times J's entries plus 10^6; tests pass 1 to take the leaves-first order).
+ * leaves-first order (0: 8 times the entries of the rows it has taken so far, plus 10^6; tests pass 1 to take
+ * the leaves-first order).
  */
 SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
                                        const SparseJacobian& J, double tolerance,
