@@ -17,7 +17,10 @@
 /// load:    loading alone: read the file, parse it and build the checked mechanism (what full spends before
 ///          the analysis), with its processor seconds;
 /// slvs:    SolveSpace's solver (libslvs) on the planar bar-and-pin models it can express (SolveSpacePeer.hpp):
-///          one Slvs_Solve, its dof; built only when libslvs is found (status=unsupported otherwise).
+///          one Slvs_Solve, its dof; built only when libslvs is found (status=unsupported otherwise);
+/// orders:  the fill and time of the self-stress basis's row elimination in the sweep's order, in SuiteSparse
+///          AMD's order of the link graph and in contract order (EliminationOrders.hpp), one line each; built
+///          when SuiteSparse AMD is found.
 /// Peak memory is the process's maximum resident set (getrusage), so run one method per process.
 
 #include <chrono>
@@ -39,6 +42,9 @@
 #endif
 #ifdef MA_HAVE_SLVS
 #include "SolveSpacePeer.hpp"
+#endif
+#ifdef MA_HAVE_AMD
+#include "EliminationOrders.hpp"
 #endif
 
 #include "mobility_analysis/analysis/FiniteMobility.hpp"
@@ -63,7 +69,7 @@ double cpuSeconds() {
 }
 
 constexpr const char* kUsage =
-    "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|load|slvs FILE.urdf [--mode M] [--budget S] [--orientation auto|J|JT]";
+    "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|load|slvs|orders FILE.urdf [--mode M] [--budget S] [--orientation auto|J|JT]";
 
 int fail(const std::string& line) {
   std::cerr << line << std::endl;
@@ -91,7 +97,8 @@ int main(int argc, char** argv) {
     }
   }
   if (file.empty() || (method != "full" && method != "finite" && method != "literal" && method != "dense" &&
-                       method != "spqr" && method != "parse" && method != "load" && method != "slvs")) {
+                       method != "spqr" && method != "parse" && method != "load" && method != "slvs" &&
+                       method != "orders")) {
     return fail(kUsage);
   }
   const Result<AnalysisMode> mode = parseAnalysisMode(modeText);
@@ -201,6 +208,18 @@ int main(int argc, char** argv) {
     std::cerr << "mobility_benchmark was built without libslvs (libslvs1-dev)" << std::endl;
 #endif
     return 0;
+  } else if (method == "orders") {
+#ifdef MA_HAVE_AMD
+    // Issue 13, item 2: the sweep's elimination order against a fill-reducing order of the link graph.
+    const Result<AssembledMechanism> assembled =
+        assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
+    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
+    const SparseJacobian J = computeConstraintJacobian(valueOf(assembled).model, valueOf(assembled).q);
+    return printEliminationOrders(valueOf(mechanism), valueOf(assembled).model, J, file);
+#else
+    status = "unsupported";
+    std::cerr << "mobility_benchmark was built without SuiteSparse AMD" << std::endl;
+#endif
   } else if (method == "spqr") {
     // One sparse rank-revealing QR of the same Jacobian the full report ranks, built and row-normalised outside
     // the timed region (as for dense): the lower bound for any sparse rank answer.

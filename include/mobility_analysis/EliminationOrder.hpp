@@ -30,9 +30,28 @@ struct EliminationOrder {
  * preferred as pivots in the order their links are reached. The front of the sweep is then all the
  * elimination ever couples: a mast or ring is done in time linear in its length, a grid in its number of
  * cells times its width — whatever the URDF's joint tree, whose paths can be as long as the mechanism.
+ *
+ * Why this and not a fill-reducing order of the mechanism's graph (issue 13): SuiteSparse AMD's order of the
+ * link graph, eliminated the same way (`mobility_benchmark --method orders`, bench/RESULTS.md), stores about
+ * as much where the sweep holds (200 x 200 bar lattice 1.45 against 1.42 times J's entries, spatial SLE mast
+ * and truss mast of 10^4 units 1.05 / 1.16 against 1.10 / 1.21, ring pantograph net 1.18 both) and more where
+ * it is best (100 x 100 continuous-bar grid 1.06 against 0.74, braced lattice 2.6 against 1.3, 2.4 times the
+ * time); where the sweep from the ground fills (a chain or a long ring: past 60 times J's entries) AMD stores
+ * 1.3-1.8 times J's entries, which is what the leaves-first order the basis then takes stores as well
+ * (computeSelfStressBasis). The sweep also keeps each stress as local as the loops (the attachment rule
+ * below), which AMD's order does not aim at.
  * @param[in] mechanism the mechanism.
  * @param[in] model its natural-coordinate model.
  */
 EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateModel& model);
+
+/**
+ * @brief The same construction over another order of the links: each link's coordinates preferred as pivots
+ *        and its rigid-link and boundary equations taken in the order of @p links, each connection's when
+ *        both its links are reached. For measuring other orders against the sweep (bench: `--method orders`).
+ * @param[in] links every link once.
+ */
+EliminationOrder computeOrderOfLinks(const Mechanism& mechanism, const CoordinateModel& model,
+                                     const std::vector<int>& links);
 
 }  // namespace mobility_analysis

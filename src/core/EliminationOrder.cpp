@@ -6,42 +6,59 @@
 
 namespace mobility_analysis {
 
-EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateModel& model) {
+namespace {
+
+/// Equations grouped by what releases them, and the connections that couple links.
+struct ConnectionGraph {
+  std::vector<std::vector<int>> linkRows, boundaryRows, jointRows;
+  std::vector<std::vector<int>> incident;  ///< Per link, its connections with equations to another link.
+};
+
+ConnectionGraph connectionGraphOf(const Mechanism& mechanism, const CoordinateModel& model) {
   const int numLinks = static_cast<int>(mechanism.links.size());
   const int numJoints = static_cast<int>(mechanism.joints.size());
+  ConnectionGraph graph;
+  graph.linkRows.resize(numLinks);
+  graph.boundaryRows.resize(numLinks);
+  graph.jointRows.resize(numJoints);
+  graph.incident.resize(numLinks);
 
-  // Equations grouped by what releases them: rigid-link and boundary rows by their link, joint rows by their
-  // joint.
-  std::vector<std::vector<int>> linkRows(numLinks), boundaryRows(numLinks), jointRows(numJoints);
+  // Rigid-link and boundary rows by their link, joint rows by their joint.
   for (int r = 0; r < model.numConstraints(); ++r) {
     const ConstraintEquation& eq = model.equations[r];
     switch (eq.source) {
       case EquationSource::Link:
-        linkRows[eq.element].push_back(r);
+        graph.linkRows[eq.element].push_back(r);
         break;
       case EquationSource::Boundary:
-        boundaryRows[eq.element].push_back(r);
+        graph.boundaryRows[eq.element].push_back(r);
         break;
       case EquationSource::Joint:
-        jointRows[eq.element].push_back(r);
+        graph.jointRows[eq.element].push_back(r);
         break;
     }
   }
   // Only connections with equations couple their links: a floating joint (a link held by loop joints alone)
   // or a slack cable would let the sweep jump from the ground straight into the middle of the mechanism.
-  std::vector<std::vector<int>> incident(numLinks);
-  auto otherEnd = [&](int joint, int link) {
-    return mechanism.joints[joint].link1 == link ? mechanism.joints[joint].link2
-                                                 : mechanism.joints[joint].link1;
-  };
   for (int j = 0; j < numJoints; ++j) {
     const Joint& joint = mechanism.joints[j];
-    if (jointRows[j].empty() || joint.link1 == joint.link2)
+    if (graph.jointRows[j].empty() || joint.link1 == joint.link2)
       continue;
-    incident[joint.link1].push_back(j);
-    incident[joint.link2].push_back(j);
+    graph.incident[joint.link1].push_back(j);
+    graph.incident[joint.link2].push_back(j);
   }
+  return graph;
+}
 
+int otherEnd(const Mechanism& mechanism, int joint, int link) {
+  return mechanism.joints[joint].link1 == link ? mechanism.joints[joint].link2
+                                               : mechanism.joints[joint].link1;
+}
+
+/// The links in the order of a maximum cardinality search from the ground (computeSweepOrder).
+std::vector<int> maximumCardinalitySweep(const Mechanism& mechanism, const ConnectionGraph& graph) {
+  const int numLinks = static_cast<int>(mechanism.links.size());
+  const std::vector<std::vector<int>>& incident = graph.incident;
   // Maximum cardinality search from the ground: the next link is the one with the most links already swept
   // among its neighbours (ties: the one touched first, so the sweep advances like a front). A link reached
   // this way closes every loop it can right away, which keeps the front narrow and, with the attachment rule
@@ -55,7 +72,7 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
     discovered[link] = static_cast<int>(sweep.size());
     sweep.push_back(link);
     for (int j : incident[link]) {
-      const int other = otherEnd(j, link);
+      const int other = otherEnd(mechanism, j, link);
       if (discovered[other] >= 0)
         continue;
       if (touched[other] < 0)
@@ -78,6 +95,17 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
       sweepLink(link);
     }
   }
+  return sweep;
+}
+
+/// The rows and column priorities of a sweep over the links in @p sweep (computeSweepOrder).
+EliminationOrder orderFromSweep(const Mechanism& mechanism, const CoordinateModel& model,
+                                const ConnectionGraph& graph, const std::vector<int>& sweep) {
+  const std::vector<std::vector<int>>& incident = graph.incident;
+  const std::vector<std::vector<int>>& jointRows = graph.jointRows;
+  std::vector<int> discovered(mechanism.links.size(), -1);
+  for (size_t i = 0; i < sweep.size(); ++i)
+    discovered[sweep[i]] = static_cast<int>(i);
 
   // Each link attaches to the most recently discovered of its earlier neighbours, and its other connections
   // to earlier links close loops. Why the most recent: the redundant equations an elimination reveals are
@@ -111,22 +139,22 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
           order.columnPriority[model.elements[e].offset + i] = nextColumn++;
       }
     }
-    order.rows.insert(order.rows.end(), linkRows[link].begin(), linkRows[link].end());
-    order.rows.insert(order.rows.end(), boundaryRows[link].begin(), boundaryRows[link].end());
+    order.rows.insert(order.rows.end(), graph.linkRows[link].begin(), graph.linkRows[link].end());
+    order.rows.insert(order.rows.end(), graph.boundaryRows[link].begin(), graph.boundaryRows[link].end());
     closing.clear();
     int attaching = -1;
     for (int j : incident[link]) {
-      const int other = otherEnd(j, link);
+      const int other = otherEnd(mechanism, j, link);
       if (discovered[other] >= discovered[link])
         continue;
       closing.push_back(j);
-      if (attaching < 0 || discovered[other] > discovered[otherEnd(attaching, link)])
+      if (attaching < 0 || discovered[other] > discovered[otherEnd(mechanism, attaching, link)])
         attaching = j;
     }
     std::stable_sort(closing.begin(), closing.end(), [&](int a, int b) {
       if ((a == attaching) != (b == attaching))
         return a == attaching;
-      return discovered[otherEnd(a, link)] > discovered[otherEnd(b, link)];
+      return discovered[otherEnd(mechanism, a, link)] > discovered[otherEnd(mechanism, b, link)];
     });
     for (int j : closing) {
       order.rows.insert(order.rows.end(), jointRows[j].begin(), jointRows[j].end());
@@ -137,6 +165,18 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
     }
   }
   return order;
+}
+
+}  // namespace
+
+EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateModel& model) {
+  const ConnectionGraph graph = connectionGraphOf(mechanism, model);
+  return orderFromSweep(mechanism, model, graph, maximumCardinalitySweep(mechanism, graph));
+}
+
+EliminationOrder computeOrderOfLinks(const Mechanism& mechanism, const CoordinateModel& model,
+                                     const std::vector<int>& links) {
+  return orderFromSweep(mechanism, model, connectionGraphOf(mechanism, model), links);
 }
 
 }  // namespace mobility_analysis

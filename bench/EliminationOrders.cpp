@@ -1,0 +1,110 @@
+#include "EliminationOrders.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <numeric>
+#include <vector>
+
+#include <amd.h>
+
+#include "mobility_analysis/EliminationOrder.hpp"
+#include "mobility_analysis/Tolerances.hpp"
+
+namespace mobility_analysis {
+
+namespace {
+
+/// An order gives up once it has stored this many times J's entries, plus kBudgetFloor.
+constexpr size_t kBudgetFactor = 60;
+constexpr size_t kBudgetFloor = 2000000;
+
+/// The links in SuiteSparse AMD's order of the graph whose edges are the connections with equations: minimum
+/// degree takes pendant links first (a tree from its leaves) and cuts long paths and grids where it fills
+/// least.
+std::vector<int> minimumDegreeLinks(const Mechanism& mechanism, const CoordinateModel& model) {
+  const int n = static_cast<int>(mechanism.links.size());
+  std::vector<char> hasRows(mechanism.joints.size(), 0);
+  for (const ConstraintEquation& eq : model.equations) {
+    if (eq.source == EquationSource::Joint)
+      hasRows[eq.element] = 1;
+  }
+  std::vector<std::vector<int>> neighbours(n);
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    const Joint& joint = mechanism.joints[j];
+    if (!hasRows[j] || joint.link1 == joint.link2)
+      continue;
+    neighbours[joint.link1].push_back(joint.link2);
+    neighbours[joint.link2].push_back(joint.link1);
+  }
+  std::vector<int> columnStart(n + 1, 0), rowIndex;
+  for (int l = 0; l < n; ++l) {
+    std::sort(neighbours[l].begin(), neighbours[l].end());
+    neighbours[l].erase(std::unique(neighbours[l].begin(), neighbours[l].end()), neighbours[l].end());
+    rowIndex.insert(rowIndex.end(), neighbours[l].begin(), neighbours[l].end());
+    columnStart[l + 1] = static_cast<int>(rowIndex.size());
+  }
+  std::vector<int> order(n);
+  double control[AMD_CONTROL], info[AMD_INFO];
+  amd_defaults(control);
+  if (amd_order(n, columnStart.data(), rowIndex.data(), order.data(), control, info) < AMD_OK)
+    std::iota(order.begin(), order.end(), 0);
+  return order;
+}
+
+/// The rows of J in contract order, the columns by index: the lecture's order.
+EliminationOrder contractOrder(const SparseJacobian& J) {
+  EliminationOrder order;
+  order.rows.resize(J.rows());
+  std::iota(order.rows.begin(), order.rows.end(), 0);
+  order.columnPriority.resize(J.cols());
+  std::iota(order.columnPriority.begin(), order.columnPriority.end(), 0);
+  return order;
+}
+
+void eliminate(const char* name, double orderSeconds, const EliminationOrder& order, const SparseJacobian& J,
+               const std::string& file) {
+  const auto start = std::chrono::steady_clock::now();
+  SparseElimination elimination(static_cast<int>(J.cols()), order.columnPriority, tolerances::kRank, true);
+  const size_t budget = kBudgetFactor * static_cast<size_t>(J.nonZeros()) + kBudgetFloor;
+  int dependent = 0;
+  bool overBudget = false;
+  for (int r : order.rows) {
+    const double norm = J.row(r).norm();
+    if (elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent)
+      ++dependent;
+    if (elimination.storedEntries() > budget) {
+      overBudget = true;
+      break;
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "method=orders order=%s file=%s coordinates=%ld equations=%ld nnz=%ld rank=%d dependent=%d stored=%zu "
+      "stored_per_nnz=%.2f order_seconds=%.4f seconds=%.4f smallest_kept_pivot=%.3g status=%s\n",
+      name, file.c_str(), static_cast<long>(J.cols()), static_cast<long>(J.rows()),
+      static_cast<long>(J.nonZeros()), elimination.rank(), dependent, elimination.storedEntries(),
+      static_cast<double>(elimination.storedEntries()) /
+          static_cast<double>(std::max<Eigen::Index>(1, J.nonZeros())),
+      orderSeconds, seconds, elimination.smallestKeptPivot(), overBudget ? "over_budget" : "ok");
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+int printEliminationOrders(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J,
+                           const std::string& file) {
+  auto start = std::chrono::steady_clock::now();
+  const EliminationOrder sweep = computeSweepOrder(mechanism, model);
+  eliminate("sweep", secondsSince(start), sweep, J, file);
+  start = std::chrono::steady_clock::now();
+  const EliminationOrder amd = computeOrderOfLinks(mechanism, model, minimumDegreeLinks(mechanism, model));
+  eliminate("amd", secondsSince(start), amd, J, file);
+  eliminate("contract", 0.0, contractOrder(J), J, file);
+  return 0;
+}
+
+}  // namespace mobility_analysis
