@@ -62,10 +62,13 @@ EliminationOrder contractOrder(const SparseJacobian& J) {
   return order;
 }
 
+/// @param[in] pivotThreshold SparseElimination's: its default for the sweeps, 1 (the largest entry) for the
+/// contract order, as the report's own contract-order fallback takes it (RedundancyAnalysis.hpp).
 void eliminate(const char* name, double orderSeconds, const EliminationOrder& order, const SparseJacobian& J,
-               const std::string& file) {
+               const std::string& file, double pivotThreshold = -1.0) {
   const auto start = std::chrono::steady_clock::now();
-  SparseElimination elimination(static_cast<int>(J.cols()), order.columnPriority, tolerances::kRank, true);
+  SparseElimination elimination(static_cast<int>(J.cols()), order.columnPriority, tolerances::kRank, true,
+                                pivotThreshold);
   const size_t budget = kBudgetFactor * static_cast<size_t>(J.nonZeros()) + kBudgetFloor;
   int dependent = 0;
   bool overBudget = false;
@@ -103,7 +106,7 @@ int printEliminationOrders(const Mechanism& mechanism, const CoordinateModel& mo
   start = std::chrono::steady_clock::now();
   const EliminationOrder amd = computeOrderOfLinks(mechanism, model, minimumDegreeLinks(mechanism, model));
   eliminate("amd", secondsSince(start), amd, J, file);
-  eliminate("contract", 0.0, contractOrder(J), J, file);
+  eliminate("contract", 0.0, contractOrder(J), J, file, 1.0);
   return 0;
 }
 
