@@ -2,6 +2,7 @@
 /// couplings as constraints, warnings that never let a loop go silently, strictness, one-line diagnostics
 /// with hostile names, extreme numbers, deep trees.
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <regex>
@@ -716,6 +717,30 @@ TEST(Readers, ClosureFileNamesTypesAndFramesOfJoints) {
 
 // --- SDFormat
 // ------------------------------------------------------------------------------------------------
+
+/// Whether this process has mapped libsdformat (its static initialisers have run).
+bool libsdformatMapped() {
+  return readTextFile("/proc/self/maps").find("libsdformat") != std::string::npos;
+}
+
+TEST(SdfReader, LibsdformatIsLoadedOnlyWhenAnSdfFileIsRead) {
+  // Each case in a fresh process (a death test re-runs this binary for this test alone), since any earlier
+  // test that read an SDF file would have loaded it already.
+  ::testing::GTEST_FLAG(death_test_style) = "threadsafe";
+  EXPECT_EXIT(
+      {
+        const bool before = libsdformatMapped();
+        readOrFail(formatPath("four_bar_urdfplus.urdf"));
+        std::exit(!before && !libsdformatMapped() ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0), "");
+  EXPECT_EXIT(
+      {
+        readOrFail(formatPath("four_bar.sdf"));
+        std::exit(libsdformatMapped() ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0), "");
+}
 
 TEST(SdfReader, PosesFollowSdformatFrameSemantics) {
   // four_bar.sdf: the rocker placed relative_to a <frame> and flipped, j4 posed relative to its child and its

@@ -10,6 +10,7 @@
 
 #include <sdf/sdf.hh>
 
+#include "SdfReaderPlugin.hpp"
 #include "XmlValues.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
@@ -296,9 +297,8 @@ class SdfConverter {
   std::set<std::string> names_;
 };
 
-}  // namespace
-
-Result<Mechanism> readSdf(const std::string& sdfText, const std::string& fileName) {
+/// readSdf, with libsdformat: this file is the plugin libmobility_analysis_sdf.so (SdfReaderPlugin.cpp).
+Result<Mechanism> readSdfWithLibsdformat(const std::string& sdfText, const std::string& fileName) {
   const std::string file = io_detail::baseName(fileName);
   sdf::ParserConfig config;
   // Elements SDFormat does not define come back as errors (the model still loads): they become warnings.
@@ -346,4 +346,12 @@ Result<Mechanism> readSdf(const std::string& sdfText, const std::string& fileNam
   return SdfConverter(*model, file).convert(std::move(warnings));
 }
 
+}  // namespace
+
 }  // namespace mobility_analysis
+
+/// The plugin's entry point, found by name (SdfReaderPlugin.hpp).
+extern "C" __attribute__((visibility("default"))) mobility_analysis::io_detail::SdfReadFunction
+mobility_analysis_sdf_reader() {
+  return &mobility_analysis::readSdfWithLibsdformat;
+}
