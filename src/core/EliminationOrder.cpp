@@ -6,41 +6,90 @@
 
 namespace mobility_analysis {
 
+namespace {
+
+/// Connections of one link sorted by insertion, at most.
+constexpr size_t kInsertionSortMax = 16;
+
+/// Integers grouped by a key in one pooled array (compressed rows): one allocation for all keys instead of a
+/// vector per link and per joint (4 10^5 of them on a 10^5-link chain); each group keeps insertion order.
+class Buckets {
+ public:
+  explicit Buckets(int numKeys) : start_(static_cast<size_t>(numKeys) + 1, 0) {}
+  /// First pass: one more value under @p key.
+  void count(int key) { ++start_[static_cast<size_t>(key) + 1]; }
+  /// After counting: room for every value counted.
+  void allocate() {
+    for (size_t k = 1; k < start_.size(); ++k)
+      start_[k] += start_[k - 1];
+    values_.resize(start_.back());
+    fill_.assign(start_.begin(), start_.end() - 1);
+  }
+  /// Second pass, in the same order as counted: the value itself.
+  void add(int key, int value) { values_[fill_[static_cast<size_t>(key)]++] = value; }
+  const int* begin(int key) const { return values_.data() + start_[static_cast<size_t>(key)]; }
+  const int* end(int key) const { return values_.data() + start_[static_cast<size_t>(key) + 1]; }
+  bool empty(int key) const { return begin(key) == end(key); }
+
+ private:
+  std::vector<size_t> start_, fill_;
+  std::vector<int> values_;
+};
+
+/// A [begin, end) range of a bucket, for range-for.
+struct Range {
+  const int* first;
+  const int* last;
+  const int* begin() const { return first; }
+  const int* end() const { return last; }
+};
+
+}  // namespace
+
 EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateModel& model) {
   const int numLinks = static_cast<int>(mechanism.links.size());
   const int numJoints = static_cast<int>(mechanism.joints.size());
 
   // Equations grouped by what releases them: rigid-link and boundary rows by their link, joint rows by their
   // joint.
-  std::vector<std::vector<int>> linkRows(numLinks), boundaryRows(numLinks), jointRows(numJoints);
-  for (int r = 0; r < model.numConstraints(); ++r) {
-    const ConstraintEquation& eq = model.equations[r];
-    switch (eq.source) {
-      case EquationSource::Link:
-        linkRows[eq.element].push_back(r);
-        break;
-      case EquationSource::Boundary:
-        boundaryRows[eq.element].push_back(r);
-        break;
-      case EquationSource::Joint:
-        jointRows[eq.element].push_back(r);
-        break;
-    }
-  }
+  Buckets linkRowsOf(numLinks), boundaryRowsOf(numLinks), jointRowsOf(numJoints);
+  auto bucketOf = [&](EquationSource source) -> Buckets& {
+    return source == EquationSource::Link ? linkRowsOf : source == EquationSource::Boundary ? boundaryRowsOf
+                                                                                            : jointRowsOf;
+  };
+  for (const ConstraintEquation& eq : model.equations)
+    bucketOf(eq.source).count(eq.element);
+  for (Buckets* buckets : {&linkRowsOf, &boundaryRowsOf, &jointRowsOf})
+    buckets->allocate();
+  for (int r = 0; r < model.numConstraints(); ++r)
+    bucketOf(model.equations[r].source).add(model.equations[r].element, r);
+  auto linkRows = [&](int l) { return Range{linkRowsOf.begin(l), linkRowsOf.end(l)}; };
+  auto boundaryRows = [&](int l) { return Range{boundaryRowsOf.begin(l), boundaryRowsOf.end(l)}; };
+  auto jointRows = [&](int j) { return Range{jointRowsOf.begin(j), jointRowsOf.end(j)}; };
   // Only connections with equations couple their links: a floating joint (a link held by loop joints alone)
   // or a slack cable would let the sweep jump from the ground straight into the middle of the mechanism.
-  std::vector<std::vector<int>> incident(numLinks);
+  Buckets incidentOf(numLinks);
   auto otherEnd = [&](int joint, int link) {
     return mechanism.joints[joint].link1 == link ? mechanism.joints[joint].link2
                                                  : mechanism.joints[joint].link1;
   };
+  auto couples = [&](int j) {
+    return !jointRowsOf.empty(j) && mechanism.joints[j].link1 != mechanism.joints[j].link2;
+  };
   for (int j = 0; j < numJoints; ++j) {
-    const Joint& joint = mechanism.joints[j];
-    if (jointRows[j].empty() || joint.link1 == joint.link2)
-      continue;
-    incident[joint.link1].push_back(j);
-    incident[joint.link2].push_back(j);
+    if (couples(j)) {
+      incidentOf.count(mechanism.joints[j].link1);
+      incidentOf.count(mechanism.joints[j].link2);
+    }
   }
+  incidentOf.allocate();
+  for (int j = 0; j < numJoints; ++j) {
+    if (couples(j)) {
+      incidentOf.add(mechanism.joints[j].link1, j);
+      incidentOf.add(mechanism.joints[j].link2, j);
+    }
+  }
+  auto incident = [&](int l) { return Range{incidentOf.begin(l), incidentOf.end(l)}; };
 
   // Maximum cardinality search from the ground: the next link is the one with the most links already swept
   // among its neighbours (ties: the one touched first, so the sweep advances like a front). A link reached
@@ -54,7 +103,7 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
   auto sweepLink = [&](int link) {
     discovered[link] = static_cast<int>(sweep.size());
     sweep.push_back(link);
-    for (int j : incident[link]) {
+    for (int j : incident(link)) {
       const int other = otherEnd(j, link);
       if (discovered[other] >= 0)
         continue;
@@ -111,11 +160,11 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
           order.columnPriority[model.elements[e].offset + i] = nextColumn++;
       }
     }
-    order.rows.insert(order.rows.end(), linkRows[link].begin(), linkRows[link].end());
-    order.rows.insert(order.rows.end(), boundaryRows[link].begin(), boundaryRows[link].end());
+    order.rows.insert(order.rows.end(), linkRows(link).begin(), linkRows(link).end());
+    order.rows.insert(order.rows.end(), boundaryRows(link).begin(), boundaryRows(link).end());
     closing.clear();
     int attaching = -1;
-    for (int j : incident[link]) {
+    for (int j : incident(link)) {
       const int other = otherEnd(j, link);
       if (discovered[other] >= discovered[link])
         continue;
@@ -123,15 +172,26 @@ EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateM
       if (attaching < 0 || discovered[other] > discovered[otherEnd(attaching, link)])
         attaching = j;
     }
-    std::stable_sort(closing.begin(), closing.end(), [&](int a, int b) {
+    auto before = [&](int a, int b) {
       if ((a == attaching) != (b == attaching))
         return a == attaching;
       return discovered[otherEnd(a, link)] > discovered[otherEnd(b, link)];
-    });
+    };
+    // Stable either way: a link has mostly a few connections, and std::stable_sort allocates a buffer per
+    // call (10^5 links), so few are sorted by insertion.
+    if (closing.size() > kInsertionSortMax)
+      std::stable_sort(closing.begin(), closing.end(), before);
+    for (size_t i = 1; i < closing.size() && closing.size() <= kInsertionSortMax; ++i) {
+      const int j = closing[i];
+      size_t k = i;
+      for (; k > 0 && before(j, closing[k - 1]); --k)
+        closing[k] = closing[k - 1];
+      closing[k] = j;
+    }
     for (int j : closing) {
-      order.rows.insert(order.rows.end(), jointRows[j].begin(), jointRows[j].end());
+      order.rows.insert(order.rows.end(), jointRows(j).begin(), jointRows(j).end());
       if (j != attaching) {
-        for (int r : jointRows[j])
+        for (int r : jointRows(j))
           order.closing[r] = 1;
       }
     }

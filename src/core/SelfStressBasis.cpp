@@ -440,6 +440,8 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
   basis.numConstraints = m;
   basis.numCoordinates = n;
   SparseElimination elimination(n, order.columnPriority, tolerance, true);
+  elimination.reserve(std::min<size_t>(order.rows.size(), static_cast<size_t>(n)),
+                      static_cast<size_t>(J.nonZeros()));
   LocalStressFinder finder(mechanism, model, J, order, position, tolerance);
   // A traced stress longer than this is found again locally; it follows the local stresses' size, so a
   // mechanism whose loops are large is not re-solved stress by stress.

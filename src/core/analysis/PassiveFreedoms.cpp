@@ -52,7 +52,20 @@ bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
   const Eigen::LLT<Eigen::Matrix<double, L, L>> llt(g);
   if (llt.info() != Eigen::Success)
     return false;
-  const double inverseNorm = llt.solve(Eigen::Matrix<double, L, L>::Identity()).norm();
+  // G^-1 = L^-T L^-1, with L^-1 by forward substitution in fixed-size storage: llt.solve(Identity) went
+  // through Eigen's general blocked triangular solver, half the search's time on a chain (3 10^5 calls).
+  const Eigen::Matrix<double, L, L> lower = llt.matrixLLT().template triangularView<Eigen::Lower>();
+  Eigen::Matrix<double, L, L> inverseLower = Eigen::Matrix<double, L, L>::Zero();
+  for (int c = 0; c < L; ++c) {
+    inverseLower(c, c) = 1.0 / lower(c, c);
+    for (int r = c + 1; r < L; ++r) {
+      double sum = 0.0;
+      for (int k = c; k < r; ++k)
+        sum += lower(r, k) * inverseLower(k, c);
+      inverseLower(r, c) = -sum / lower(r, r);
+    }
+  }
+  const double inverseNorm = (inverseLower.transpose() * inverseLower).norm();
   return std::isfinite(inverseNorm) && inverseNorm > 0.0 && std::sqrt(1.0 / inverseNorm) > bound;
 }
 
