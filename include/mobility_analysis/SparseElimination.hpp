@@ -67,6 +67,8 @@ class SparseElimination {
   Step reduce(const SparseJacobian& J, int r, double scale);
   /// Keeps the row reduce() last reduced as a pivot row (its reduced norm must be positive).
   void keep();
+  /// Room for @p rows pivot rows holding @p entries entries in all (a hint: the storage still grows).
+  void reserve(size_t rows, size_t entries);
 
   /**
    * @brief The distance of row @p r of @p J, multiplied by @p scale, from the span of the pivot rows: the

@@ -26,12 +26,21 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
   int numColumns = 0;
   const std::vector<int> columns = allColumns(layout, numColumns);
-  Eigen::VectorXd residual;
-  evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
-                  nullptr);
-  assembled.initialResidual = maxAbs(residual) * lc;
+  // With no residual rows (a tree with no loop-closing connection, coupling or multi-freedom tree joint of
+  // its own equations) the residual is empty, its maximum 0, and closeLoops stops before its first iteration
+  // with the start's poses: those poses are taken directly, without its three evaluations.
+  const bool nothingToClose = layout.numResiduals == 0;
+  if (!nothingToClose) {
+    Eigen::VectorXd residual;
+    evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
+                    nullptr);
+    assembled.initialResidual = maxAbs(residual) * lc;
+  }
 
-  if (driven.empty()) {
+  if (driven.empty() && nothingToClose) {
+    assembled.poses = posesOf(mechanism, layout, start);
+    assembled.positions = computeJointPositions(mechanism, assembled.poses);
+  } else if (driven.empty()) {
     Result<ClosedConfiguration> closed = closeLoops(mechanism, layout, start, columns, numColumns);
     if (!isOk(closed))
       return diagnosticOf(closed);

@@ -8,57 +8,114 @@ namespace mobility_analysis {
 
 namespace {
 
-/// Equations grouped by what releases them, and the connections that couple links.
-struct ConnectionGraph {
-  std::vector<std::vector<int>> linkRows, boundaryRows, jointRows;
-  std::vector<std::vector<int>> incident;  ///< Per link, its connections with equations to another link.
+/// Connections of one link sorted by insertion, at most.
+constexpr size_t kInsertionSortMax = 16;
+
+/// Integers grouped by a key in one pooled array (compressed rows): one allocation for all keys instead of a
+/// vector per link and per joint (4 10^5 of them on a 10^5-link chain); each group keeps insertion order.
+class Buckets {
+ public:
+  explicit Buckets(int numKeys) : start_(static_cast<size_t>(numKeys) + 1, 0) {}
+  /// First pass: one more value under @p key.
+  void count(int key) { ++start_[static_cast<size_t>(key) + 1]; }
+  /// After counting: room for every value counted.
+  void allocate() {
+    for (size_t k = 1; k < start_.size(); ++k)
+      start_[k] += start_[k - 1];
+    values_.resize(start_.back());
+    fill_.assign(start_.begin(), start_.end() - 1);
+  }
+  /// Second pass, in the same order as counted: the value itself.
+  void add(int key, int value) { values_[fill_[static_cast<size_t>(key)]++] = value; }
+  const int* begin(int key) const { return values_.data() + start_[static_cast<size_t>(key)]; }
+  const int* end(int key) const { return values_.data() + start_[static_cast<size_t>(key) + 1]; }
+  bool empty(int key) const { return begin(key) == end(key); }
+
+ private:
+  std::vector<size_t> start_, fill_;
+  std::vector<int> values_;
 };
 
-ConnectionGraph connectionGraphOf(const Mechanism& mechanism, const CoordinateModel& model) {
-  const int numLinks = static_cast<int>(mechanism.links.size());
-  const int numJoints = static_cast<int>(mechanism.joints.size());
-  ConnectionGraph graph;
-  graph.linkRows.resize(numLinks);
-  graph.boundaryRows.resize(numLinks);
-  graph.jointRows.resize(numJoints);
-  graph.incident.resize(numLinks);
+/// A [begin, end) range of a bucket, for range-for.
+struct Range {
+  const int* first;
+  const int* last;
+  const int* begin() const { return first; }
+  const int* end() const { return last; }
+};
 
-  // Rigid-link and boundary rows by their link, joint rows by their joint.
-  for (int r = 0; r < model.numConstraints(); ++r) {
-    const ConstraintEquation& eq = model.equations[r];
-    switch (eq.source) {
-      case EquationSource::Link:
-        graph.linkRows[eq.element].push_back(r);
-        break;
-      case EquationSource::Boundary:
-        graph.boundaryRows[eq.element].push_back(r);
-        break;
-      case EquationSource::Joint:
-        graph.jointRows[eq.element].push_back(r);
-        break;
-    }
+/// The equations grouped by what releases them and the links each connection couples, read once from the
+/// model: what a sweep over the links needs, whatever the order of the links.
+struct SweepGraph {
+  SweepGraph(const Mechanism& mechanism, const CoordinateModel& model);
+  int numLinks;
+  Buckets rowsOf;  ///< Link rows by link, then boundary rows by link, then joint rows by joint.
+  std::vector<std::pair<int, int>> ends;
+  Buckets incidentOf;
+  std::vector<char> expressed;
+  Range linkRows(int l) const { return Range{rowsOf.begin(l), rowsOf.end(l)}; }
+  Range boundaryRows(int l) const { return Range{rowsOf.begin(numLinks + l), rowsOf.end(numLinks + l)}; }
+  Range jointRows(int j) const { return Range{rowsOf.begin(2 * numLinks + j), rowsOf.end(2 * numLinks + j)}; }
+  Range incident(int l) const { return Range{incidentOf.begin(l), incidentOf.end(l)}; }
+  int otherEnd(int joint, int link) const {
+    const std::pair<int, int>& e = ends[static_cast<size_t>(joint)];
+    return e.first == link ? e.second : e.first;
   }
+};
+
+SweepGraph::SweepGraph(const Mechanism& mechanism, const CoordinateModel& model)
+    : numLinks(static_cast<int>(mechanism.links.size())),
+      rowsOf(2 * static_cast<int>(mechanism.links.size()) + static_cast<int>(mechanism.joints.size())),
+      incidentOf(static_cast<int>(mechanism.links.size())) {
+  const int numJoints = static_cast<int>(mechanism.joints.size());
+
+  // One read of the equations (about 110 bytes each, 55 MB for 5 10^5 of them): each row's group, numbered
+  // link rows, then boundary rows by link, then joint rows by joint, and the elements that rigid-link
+  // equations express (below); the rows are then filed from those compact keys.
+  const int numRows = model.numConstraints();
+  std::vector<int> groupOfRow(static_cast<size_t>(numRows));
+  expressed.assign(model.elements.size(), 0);
+  for (int r = 0; r < numRows; ++r) {
+    const ConstraintEquation& eq = model.equations[r];
+    const int group = eq.source == EquationSource::Link       ? eq.element
+                      : eq.source == EquationSource::Boundary ? numLinks + eq.element
+                                                              : 2 * numLinks + eq.element;
+    groupOfRow[static_cast<size_t>(r)] = group;
+    rowsOf.count(group);
+    if (eq.form == EquationForm::Combination)
+      expressed[eq.target] = 1;
+  }
+  rowsOf.allocate();
+  for (int r = 0; r < numRows; ++r)
+    rowsOf.add(groupOfRow[static_cast<size_t>(r)], r);
+  // Each connection's two links, read once (a Joint holds its frames and name: hundreds of bytes).
+  ends.resize(static_cast<size_t>(numJoints));
+  for (int j = 0; j < numJoints; ++j)
+    ends[static_cast<size_t>(j)] = {mechanism.joints[j].link1, mechanism.joints[j].link2};
   // Only connections with equations couple their links: a floating joint (a link held by loop joints alone)
   // or a slack cable would let the sweep jump from the ground straight into the middle of the mechanism.
+  auto couples = [&](int j) {
+    return !rowsOf.empty(2 * numLinks + j) &&
+           ends[static_cast<size_t>(j)].first != ends[static_cast<size_t>(j)].second;
+  };
   for (int j = 0; j < numJoints; ++j) {
-    const Joint& joint = mechanism.joints[j];
-    if (graph.jointRows[j].empty() || joint.link1 == joint.link2)
-      continue;
-    graph.incident[joint.link1].push_back(j);
-    graph.incident[joint.link2].push_back(j);
+    if (couples(j)) {
+      incidentOf.count(ends[static_cast<size_t>(j)].first);
+      incidentOf.count(ends[static_cast<size_t>(j)].second);
+    }
   }
-  return graph;
-}
-
-int otherEnd(const Mechanism& mechanism, int joint, int link) {
-  return mechanism.joints[joint].link1 == link ? mechanism.joints[joint].link2
-                                               : mechanism.joints[joint].link1;
+  incidentOf.allocate();
+  for (int j = 0; j < numJoints; ++j) {
+    if (couples(j)) {
+      incidentOf.add(ends[static_cast<size_t>(j)].first, j);
+      incidentOf.add(ends[static_cast<size_t>(j)].second, j);
+    }
+  }
 }
 
 /// The links in the order of a maximum cardinality search from the ground (computeSweepOrder).
-std::vector<int> maximumCardinalitySweep(const Mechanism& mechanism, const ConnectionGraph& graph) {
-  const int numLinks = static_cast<int>(mechanism.links.size());
-  const std::vector<std::vector<int>>& incident = graph.incident;
+std::vector<int> maximumCardinalitySweep(const Mechanism& mechanism, const SweepGraph& graph) {
+  const int numLinks = graph.numLinks;
   // Maximum cardinality search from the ground: the next link is the one with the most links already swept
   // among its neighbours (ties: the one touched first, so the sweep advances like a front). A link reached
   // this way closes every loop it can right away, which keeps the front narrow and, with the attachment rule
@@ -71,8 +128,8 @@ std::vector<int> maximumCardinalitySweep(const Mechanism& mechanism, const Conne
   auto sweepLink = [&](int link) {
     discovered[link] = static_cast<int>(sweep.size());
     sweep.push_back(link);
-    for (int j : incident[link]) {
-      const int other = otherEnd(mechanism, j, link);
+    for (int j : graph.incident(link)) {
+      const int other = graph.otherEnd(j, link);
       if (discovered[other] >= 0)
         continue;
       if (touched[other] < 0)
@@ -98,15 +155,14 @@ std::vector<int> maximumCardinalitySweep(const Mechanism& mechanism, const Conne
   return sweep;
 }
 
-/// The rows and column priorities of a sweep over the links in @p sweep (computeSweepOrder).
-EliminationOrder orderFromSweep(const Mechanism& mechanism, const CoordinateModel& model,
-                                const ConnectionGraph& graph, const std::vector<int>& sweep) {
-  const std::vector<std::vector<int>>& incident = graph.incident;
-  const std::vector<std::vector<int>>& jointRows = graph.jointRows;
-  std::vector<int> discovered(mechanism.links.size(), -1);
+/// The rows and column priorities of a sweep over the links in the order @p sweep (computeSweepOrder).
+EliminationOrder orderFromSweep(const CoordinateModel& model, const SweepGraph& graph,
+                                const std::vector<int>& sweep) {
+  std::vector<int> discovered(static_cast<size_t>(graph.numLinks), -1);
   for (size_t i = 0; i < sweep.size(); ++i)
     discovered[sweep[i]] = static_cast<int>(i);
-
+  const std::vector<char>& expressed = graph.expressed;
+  auto otherEnd = [&](int joint, int link) { return graph.otherEnd(joint, link); };
   // Each link attaches to the most recently discovered of its earlier neighbours, and its other connections
   // to earlier links close loops. Why the most recent: the redundant equations an elimination reveals are
   // those of the connection that closes a loop, and its self-stress is the unique one over that connection
@@ -125,11 +181,7 @@ EliminationOrder orderFromSweep(const Mechanism& mechanism, const CoordinateMode
   // its joints reduce onto the basis alone. With the basis first, the equations would pivot on it one after
   // the other and couple every element of the link (quadratic for a door on many hinges or a bar through many
   // pins).
-  std::vector<char> expressed(model.elements.size(), 0);
-  for (const ConstraintEquation& eq : model.equations) {
-    if (eq.form == EquationForm::Combination)
-      expressed[eq.target] = 1;
-  }
+  // (expressed: marked when SweepGraph read the equations.)
   for (int link : sweep) {
     for (const char wanted : {1, 0}) {
       for (int e : model.bodyElements[link]) {
@@ -139,27 +191,38 @@ EliminationOrder orderFromSweep(const Mechanism& mechanism, const CoordinateMode
           order.columnPriority[model.elements[e].offset + i] = nextColumn++;
       }
     }
-    order.rows.insert(order.rows.end(), graph.linkRows[link].begin(), graph.linkRows[link].end());
-    order.rows.insert(order.rows.end(), graph.boundaryRows[link].begin(), graph.boundaryRows[link].end());
+    order.rows.insert(order.rows.end(), graph.linkRows(link).begin(), graph.linkRows(link).end());
+    order.rows.insert(order.rows.end(), graph.boundaryRows(link).begin(), graph.boundaryRows(link).end());
     closing.clear();
     int attaching = -1;
-    for (int j : incident[link]) {
-      const int other = otherEnd(mechanism, j, link);
+    for (int j : graph.incident(link)) {
+      const int other = otherEnd(j, link);
       if (discovered[other] >= discovered[link])
         continue;
       closing.push_back(j);
-      if (attaching < 0 || discovered[other] > discovered[otherEnd(mechanism, attaching, link)])
+      if (attaching < 0 || discovered[other] > discovered[otherEnd(attaching, link)])
         attaching = j;
     }
-    std::stable_sort(closing.begin(), closing.end(), [&](int a, int b) {
+    auto before = [&](int a, int b) {
       if ((a == attaching) != (b == attaching))
         return a == attaching;
-      return discovered[otherEnd(mechanism, a, link)] > discovered[otherEnd(mechanism, b, link)];
-    });
+      return discovered[otherEnd(a, link)] > discovered[otherEnd(b, link)];
+    };
+    // Stable either way: a link has mostly a few connections, and std::stable_sort allocates a buffer per
+    // call (10^5 links), so few are sorted by insertion.
+    if (closing.size() > kInsertionSortMax)
+      std::stable_sort(closing.begin(), closing.end(), before);
+    for (size_t i = 1; i < closing.size() && closing.size() <= kInsertionSortMax; ++i) {
+      const int j = closing[i];
+      size_t k = i;
+      for (; k > 0 && before(j, closing[k - 1]); --k)
+        closing[k] = closing[k - 1];
+      closing[k] = j;
+    }
     for (int j : closing) {
-      order.rows.insert(order.rows.end(), jointRows[j].begin(), jointRows[j].end());
+      order.rows.insert(order.rows.end(), graph.jointRows(j).begin(), graph.jointRows(j).end());
       if (j != attaching) {
-        for (int r : jointRows[j])
+        for (int r : graph.jointRows(j))
           order.closing[r] = 1;
       }
     }
@@ -170,13 +233,13 @@ EliminationOrder orderFromSweep(const Mechanism& mechanism, const CoordinateMode
 }  // namespace
 
 EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateModel& model) {
-  const ConnectionGraph graph = connectionGraphOf(mechanism, model);
-  return orderFromSweep(mechanism, model, graph, maximumCardinalitySweep(mechanism, graph));
+  const SweepGraph graph(mechanism, model);
+  return orderFromSweep(model, graph, maximumCardinalitySweep(mechanism, graph));
 }
 
 EliminationOrder computeOrderOfLinks(const Mechanism& mechanism, const CoordinateModel& model,
                                      const std::vector<int>& links) {
-  return orderFromSweep(mechanism, model, connectionGraphOf(mechanism, model), links);
+  return orderFromSweep(model, SweepGraph(mechanism, model), links);
 }
 
 }  // namespace mobility_analysis

@@ -1,6 +1,7 @@
 #include "mobility_analysis/MobilityAnalysis.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <set>
 
 #include "mobility_analysis/ConstraintJacobian.hpp"
@@ -116,10 +117,18 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   report.closureResidualBefore = analysis.assembled.initialResidual;
   report.closureResidualAfter = analysis.assembled.finalResidual;
   const JointPositions& reached = analysis.assembled.positions;
+  // Joints are mostly written in the order of their names (the map's order): the entry after the last one
+  // found is tried first, so the walk costs one comparison per joint instead of a search of the map.
+  auto next = reached.begin();
+  report.positions.reserve(reached.size());
   for (const Joint& joint : mechanism.joints) {
-    const auto value = reached.find(joint.name);
-    if (joint.kind == ConnectionKind::TreeJoint && value != reached.end())
-      report.positions.push_back(JointValue{joint.name, value->second});
+    if (joint.kind != ConnectionKind::TreeJoint)
+      continue;
+    const auto value = next != reached.end() && next->first == joint.name ? next : reached.find(joint.name);
+    if (value == reached.end())
+      continue;
+    report.positions.push_back(JointValue{joint.name, value->second});
+    next = std::next(value);
   }
   report.assembly.residual = analysis.assembled.finalResidual;
   report.assembly.steps = analysis.assembled.steps;
@@ -186,6 +195,8 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
       report.redundantLinks.push_back(mechanism.links[l].name);
   }
 
+  report.links.reserve(mechanism.links.size());
+  report.joints.reserve(mechanism.joints.size());
   for (size_t l = 0; l < mechanism.links.size(); ++l) {
     const ElementClass c = linkRedundant[l] ? ElementClass::Redundant
                            : linkInLoop[l]  ? ElementClass::OverConstrainedLoop

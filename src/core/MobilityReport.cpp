@@ -21,6 +21,16 @@ namespace {
 void appendQuoted(std::string& out, const std::string& text) {
   out += '"';
   for (size_t i = 0; i < text.size(); ++i) {
+    // A run of characters that need no escape goes in at once (most names are all of one run).
+    size_t plain = i;
+    while (plain < text.size() && static_cast<unsigned char>(text[plain]) >= 0x20 &&
+           static_cast<unsigned char>(text[plain]) < 0x80 && text[plain] != '"' && text[plain] != '\\')
+      ++plain;
+    if (plain > i) {
+      out.append(text, i, plain - i);
+      i = plain - 1;
+      continue;
+    }
     const char c = text[i];
     if (static_cast<unsigned char>(c) >= 0x80) {  // JSON is UTF-8: a byte outside a valid sequence is U+FFFD
       const int length = utf8SequenceLength(text, i);

@@ -455,7 +455,18 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
   basis.numConstraints = m;
   basis.numCoordinates = n;
   SparseElimination elimination(n, order.columnPriority, tolerance, true);
-  LocalStressFinder finder(mechanism, model, J, order, position, tolerance);
+  // A sweep that runs to the end (a tree's) stores at least J's entries: room for them at once. One that may
+  // be abandoned at its fill budget grows as it goes (reserved, it raised a ring's peak by 50 MB).
+  if (fillBudget == 0)
+    elimination.reserve(std::min<size_t>(order.rows.size(), static_cast<size_t>(n)),
+                        static_cast<size_t>(J.nonZeros()));
+  // Built at the first dependent row: a tree has none, and its graph costs a vector per link and joint.
+  std::optional<LocalStressFinder> lazyFinder;
+  auto finder = [&]() -> LocalStressFinder& {
+    if (!lazyFinder)
+      lazyFinder.emplace(mechanism, model, J, order, position, tolerance);
+    return *lazyFinder;
+  };
   // A traced stress longer than this is found again locally; it follows the local stresses' size, so a
   // mechanism whose loops are large is not re-solved stress by stress.
   size_t traceLimit = kTraceLimit;
@@ -482,8 +493,8 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
     // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
     // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
     std::optional<SelfStress> stress;
-    if (finder.inSpaceFirst() && futileFinds < kFutileFinds) {
-      stress = finder.find(r);
+    if (finder().inSpaceFirst() && futileFinds < kFutileFinds) {
+      stress = finder().find(r);
       if (stress)
         ++basis.locallyResolved;
       else
@@ -492,7 +503,7 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
     if (!stress)
       stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
     if (!stress && futileFinds < kFutileFinds) {
-      stress = finder.find(r);
+      stress = finder().find(r);
       if (stress) {
         ++basis.locallyResolved;
         traceLimit = std::max(traceLimit, 2 * stress->size());

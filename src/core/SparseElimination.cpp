@@ -151,6 +151,16 @@ void SparseElimination::keep() {
   queued_.push_back(0);
 }
 
+void SparseElimination::reserve(size_t rows, size_t entries) {
+  origin_.reserve(rows);
+  column_.reserve(rows);
+  pivot_.reserve(rows);
+  entryStart_.reserve(rows + 1);
+  multiplierStart_.reserve(rows + 1);
+  queued_.reserve(rows);
+  entries_.reserve(entries);
+}
+
 std::optional<double> SparseElimination::distanceFromPivotRows(const SparseJacobian& J, int r, double scale,
                                                                size_t maxNullity) const {
   const std::optional<std::vector<Eigen::VectorXd>> basis = nullSpace(maxNullity);

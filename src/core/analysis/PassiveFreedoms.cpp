@@ -52,9 +52,32 @@ bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
   const Eigen::LLT<Eigen::Matrix<double, L, L>> llt(g);
   if (llt.info() != Eigen::Success)
     return false;
-  const double inverseNorm = llt.solve(Eigen::Matrix<double, L, L>::Identity()).norm();
+  // G^-1 = L^-T L^-1, with L^-1 by forward substitution in fixed-size storage: llt.solve(Identity) went
+  // through Eigen's general blocked triangular solver, half the search's time on a chain (3 10^5 calls).
+  const Eigen::Matrix<double, L, L> lower = llt.matrixLLT().template triangularView<Eigen::Lower>();
+  Eigen::Matrix<double, L, L> inverseLower = Eigen::Matrix<double, L, L>::Zero();
+  for (int c = 0; c < L; ++c) {
+    inverseLower(c, c) = 1.0 / lower(c, c);
+    for (int r = c + 1; r < L; ++r) {
+      double sum = 0.0;
+      for (int k = c; k < r; ++k)
+        sum += lower(r, k) * inverseLower(k, c);
+      inverseLower(r, c) = -sum / lower(r, r);
+    }
+  }
+  const double inverseNorm = (inverseLower.transpose() * inverseLower).norm();
   return std::isfinite(inverseNorm) && inverseNorm > 0.0 && std::sqrt(1.0 / inverseNorm) > bound;
 }
+
+/// A link's connections: a range in one pooled array (one allocation for all links, not one per link).
+struct ConnectionRange {
+  const int* first;
+  const int* last;
+  const int* begin() const { return first; }
+  const int* end() const { return last; }
+  size_t size() const { return static_cast<size_t>(last - first); }
+  int operator[](size_t i) const { return first[i]; }
+};
 
 /// The mechanism at the pose q as the search reads it: the connections that constrain at each link, each
 /// Jacobian row's norm, and the rows of T (the twist of a rigid group mapped onto its coordinates).
@@ -78,8 +101,18 @@ struct SearchContext {
   const int dim;
   const bool planar;
   const int lambda;
-  std::vector<std::vector<int>> connectionsAt;  ///< Per link, the connections that constrain it.
-  std::vector<double> rowNorm;                  ///< Per row of J, its norm.
+  /// Per link, the connections that constrain it (in connection order).
+  ConnectionRange connectionsAt(int l) const {
+    return ConnectionRange{connections_.data() + connectionStart_[static_cast<size_t>(l)],
+                           connections_.data() + connectionStart_[static_cast<size_t>(l) + 1]};
+  }
+  std::vector<std::pair<int, int>> jointEnds;  ///< Per connection, link1 and link2 (read once: a Joint is
+                                               ///< hundreds of bytes).
+  std::vector<double> rowNorm;                 ///< Per row of J, its norm.
+
+ private:
+  std::vector<size_t> connectionStart_;  // per link, into connections_ (compressed rows)
+  std::vector<int> connections_;
 };
 
 SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& model,
@@ -92,19 +125,32 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
       dim(model.dim),
       planar(model.dim == 2),
       lambda(model.lambda),
-      connectionsAt(static_cast<size_t>(numLinks)),
-      rowNorm(static_cast<size_t>(J.rows())) {
-  // Connections that constrain, and the links they join.
+      jointEnds(mechanism.joints.size()),
+      rowNorm(static_cast<size_t>(J.rows())),
+      connectionStart_(static_cast<size_t>(numLinks) + 1, 0) {
+  // Connections that constrain, and the links they join (a connection joining a link to itself is listed
+  // twice there, as before).
   std::vector<int> equationsOf(mechanism.joints.size(), 0);
   for (const ConstraintEquation& eq : model.equations) {
     if (eq.source == EquationSource::Joint)
       ++equationsOf[eq.element];
   }
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    jointEnds[j] = {mechanism.joints[j].link1, mechanism.joints[j].link2};
     if (equationsOf[j] == 0)
       continue;
-    connectionsAt[mechanism.joints[j].link1].push_back(static_cast<int>(j));
-    connectionsAt[mechanism.joints[j].link2].push_back(static_cast<int>(j));
+    ++connectionStart_[static_cast<size_t>(jointEnds[j].first) + 1];
+    ++connectionStart_[static_cast<size_t>(jointEnds[j].second) + 1];
+  }
+  for (size_t l = 1; l < connectionStart_.size(); ++l)
+    connectionStart_[l] += connectionStart_[l - 1];
+  connections_.resize(connectionStart_.back());
+  std::vector<size_t> fill(connectionStart_.begin(), connectionStart_.end() - 1);
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    if (equationsOf[j] == 0)
+      continue;
+    connections_[fill[static_cast<size_t>(jointEnds[j].first)]++] = static_cast<int>(j);
+    connections_[fill[static_cast<size_t>(jointEnds[j].second)]++] = static_cast<int>(j);
   }
   // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
   for (Eigen::Index r = 0; r < J.rows(); ++r)
@@ -138,8 +184,8 @@ TwistRow SearchContext::twistRow(int e, int k) const {
 }
 
 int SearchContext::otherLink(int j, int l) const {
-  const Joint& joint = mechanism.joints[j];
-  return joint.link1 == l ? joint.link2 : joint.link1;
+  const std::pair<int, int>& ends = jointEnds[static_cast<size_t>(j)];
+  return ends.first == l ? ends.second : ends.first;
 }
 
 /// The end-connection bound (PassiveFreedomsOptions, with its proof): per link l, F_l = the sum over the
@@ -235,10 +281,11 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
 void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
   const int lambda = context_.lambda;
   const ConstraintEquation& eq = context_.model.equations[static_cast<size_t>(r)];
-  const Joint* joint = eq.source == EquationSource::Joint ? &context_.mechanism.joints[eq.element] : nullptr;
+  const std::pair<int, int>* joint =
+      eq.source == EquationSource::Joint ? &context_.jointEnds[static_cast<size_t>(eq.element)] : nullptr;
   bool twoLinks = joint != nullptr && !parts.overflow;
   for (size_t s = 0; s < parts.used; ++s)
-    twoLinks = twoLinks && (parts.perLink[s].first == joint->link1 || parts.perLink[s].first == joint->link2);
+    twoLinks = twoLinks && (parts.perLink[s].first == joint->first || parts.perLink[s].first == joint->second);
   for (size_t s = 0; s < parts.used; ++s) {
     const int l = parts.perLink[s].first;
     linkFrobenius_[static_cast<size_t>(l)] +=
@@ -257,7 +304,7 @@ void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
     }
   }
   if (joint != nullptr && !twoLinks) {  // this connection's rows are not all rows of A on the end link
-    for (int l : {joint->link1, joint->link2}) {
+    for (int l : {joint->first, joint->second}) {
       const int end = slotOf(l, eq.element);
       if (end >= 0)
         endValid_[static_cast<size_t>(l) * 2 + static_cast<size_t>(end)] = 0;
@@ -266,7 +313,7 @@ void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
 }
 
 int EndConnectionBound::slotOf(int link, int joint) const {
-  const std::vector<int>& at = context_.connectionsAt[link];
+  const ConnectionRange at = context_.connectionsAt(link);
   return at.size() != 2 ? -1 : at[0] == joint ? 0 : at[1] == joint ? 1 : -1;
 }
 
@@ -278,7 +325,7 @@ bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
   for (int l : path) {
     frobenius2 += linkFrobenius_[static_cast<size_t>(l)];
     for (size_t s = 0; s < 2; ++s) {
-      const int other = context_.otherLink(context_.connectionsAt[l][s], l);
+      const int other = context_.otherLink(context_.connectionsAt(l)[s], l);
       if (std::find(path.begin(), path.end(), other) != path.end())
         continue;
       const size_t at = static_cast<size_t>(l) * 2 + s;
@@ -334,11 +381,11 @@ void extendChain(const SearchContext& context, std::vector<int>& path, const End
   if (path.size() >= kMaxGroup)
     return;
   const int last = path.back();
-  if (context.connectionsAt[last].size() != 2)
+  if (context.connectionsAt(last).size() != 2)
     return;
-  for (int j : context.connectionsAt[last]) {
+  for (int j : context.connectionsAt(last)) {
     const int next = context.otherLink(j, last);
-    if (next == context.mechanism.rootLink || context.connectionsAt[next].size() != 2 ||
+    if (next == context.mechanism.rootLink || context.connectionsAt(next).size() != 2 ||
         std::find(path.begin(), path.end(), next) != path.end())
       continue;
     path.push_back(next);
@@ -354,7 +401,7 @@ CandidateGroups findCandidateGroups(const SearchContext& context, const EndConne
   CandidateGroups candidates;
   std::vector<int> chain;
   for (int l = 0; l < context.numLinks; ++l) {
-    if (l == context.mechanism.rootLink || context.connectionsAt[l].size() != 2)
+    if (l == context.mechanism.rootLink || context.connectionsAt(l).size() != 2)
       continue;
     chain.assign(1, l);
     addGroup(chain, bound, candidates);
@@ -446,7 +493,7 @@ bool GroupSearch::hasTwoEndsToTwoLinks() {
   const Mechanism& mechanism = context_.mechanism;
   outside_.clear();
   for (int l : group_) {
-    for (int j : context_.connectionsAt[l]) {
+    for (int j : context_.connectionsAt(l)) {
       const Joint& joint = mechanism.joints[j];
       if (!inGroup_[joint.link1])
         outside_.push_back(joint.link1);
@@ -458,7 +505,7 @@ bool GroupSearch::hasTwoEndsToTwoLinks() {
   outside_.erase(std::unique(outside_.begin(), outside_.end()), outside_.end());
   int ends = 0;
   for (int l : group_) {
-    for (int j : context_.connectionsAt[l])
+    for (int j : context_.connectionsAt(l))
       ends += inGroup_[mechanism.joints[j].link1] && inGroup_[mechanism.joints[j].link2] ? 0 : 1;
   }
   return outside_.size() >= 2 && ends == 2;
@@ -680,7 +727,7 @@ std::string GroupSearch::endsPhrase() const {
   std::vector<int> ends;
   std::set<std::string> types;
   for (int l : group_) {
-    for (int j : context_.connectionsAt[l]) {
+    for (int j : context_.connectionsAt(l)) {
       const Joint& joint = mechanism.joints[j];
       if (inGroup_[joint.link1] && inGroup_[joint.link2])
         continue;

@@ -10,6 +10,7 @@ void addBodyBases(ModelBuilder& builder) {
   CoordinateModel& model = builder.model;
   const bool planar = builder.planar();
   builder.bases.assign(mechanism.links.size(), BodyBasis{});
+  std::vector<Direction> candidates;  // per body, reused (no allocation per body)
   // p0 and the best-conditioned directions; auxiliary unit vectors where the joints give too few.
   for (size_t b = 0; b < mechanism.links.size(); ++b) {
     const int body = static_cast<int>(b);
@@ -23,7 +24,7 @@ void addBodyBases(ModelBuilder& builder) {
     if (basis.p0 < 0) {
       basis.p0 = builder.addElement(body, true, Eigen::Vector3d::Zero(), ElementRole::Origin);
     }
-    std::vector<Direction> candidates;
+    candidates.clear();
     for (int e : model.bodyElements[b]) {
       if (e == basis.p0)
         continue;

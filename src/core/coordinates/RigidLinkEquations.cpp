@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 
 #include <Eigen/Dense>
 
@@ -24,11 +25,10 @@ void addRigidLinkEquations(ModelBuilder& builder) {
   model.equations.reserve(model.equations.size() + count + static_cast<size_t>(2 * model.lambda));
   for (size_t b = 0; b < builder.mechanism.links.size(); ++b) {
     const BodyBasis& basis = builder.bases[b];
-    std::vector<Direction> dirs = {basis.d1};
-    if (!planar)
-      dirs.push_back(basis.d2);
-    for (size_t i = 0; i < dirs.size(); ++i) {
-      for (size_t j = i; j < dirs.size(); ++j) {
+    const std::array<Direction, 2> dirs = {basis.d1, basis.d2};
+    const size_t numDirs = planar ? 1 : 2;
+    for (size_t i = 0; i < numDirs; ++i) {
+      for (size_t j = i; j < numDirs; ++j) {
         ConstraintEquation eq;
         eq.source = EquationSource::Link;
         eq.element = static_cast<int>(b);
