@@ -431,6 +431,7 @@ struct FillBudget {
   static FillBudget none() { return {}; }
   static FillBudget total(size_t entries) { return {entries, 0}; }
   static FillBudget proportional(size_t factor) { return {0, factor}; }
+  bool unlimited() const { return entries == 0 && perRowEntry == 0; }
   bool exceeded(size_t stored, size_t rowEntries) const {
     return (entries > 0 && stored > entries) ||
            (perRowEntry > 0 && stored > perRowEntry * rowEntries + kFillFloor);
@@ -457,7 +458,7 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
   SparseElimination elimination(n, order.columnPriority, tolerance, true);
   // A sweep that runs to the end (a tree's) stores at least J's entries: room for them at once. One that may
   // be abandoned at its fill budget grows as it goes (reserved, it raised a ring's peak by 50 MB).
-  if (fillBudget == 0)
+  if (fillBudget.unlimited())
     elimination.reserve(std::min<size_t>(order.rows.size(), static_cast<size_t>(n)),
                         static_cast<size_t>(J.nonZeros()));
   // Built at the first dependent row: a tree has none, and its graph costs a vector per link and joint.
