@@ -109,6 +109,7 @@ struct SearchContext {
   std::vector<std::pair<int, int>> jointEnds;  ///< Per connection, link1 and link2 (read once: a Joint is
                                                ///< hundreds of bytes).
   std::vector<double> rowNorm;                 ///< Per row of J, its norm.
+  std::vector<int> jointOfRow;                 ///< Per row of J, its connection (-1: a link's, the ground's).
 
  private:
   std::vector<size_t> connectionStart_;  // per link, into connections_ (compressed rows)
@@ -130,10 +131,15 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
       connectionStart_(static_cast<size_t>(numLinks) + 1, 0) {
   // Connections that constrain, and the links they join (a connection joining a link to itself is listed
   // twice there, as before).
+  // (One read of the equations, 110 bytes each, for the bound's rows too.)
   std::vector<int> equationsOf(mechanism.joints.size(), 0);
-  for (const ConstraintEquation& eq : model.equations) {
-    if (eq.source == EquationSource::Joint)
+  jointOfRow.assign(model.equations.size(), -1);
+  for (size_t r = 0; r < model.equations.size(); ++r) {
+    const ConstraintEquation& eq = model.equations[r];
+    if (eq.source == EquationSource::Joint) {
       ++equationsOf[eq.element];
+      jointOfRow[r] = eq.element;
+    }
   }
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     jointEnds[j] = {mechanism.joints[j].link1, mechanism.joints[j].link2};
@@ -280,9 +286,9 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
 
 void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
   const int lambda = context_.lambda;
-  const ConstraintEquation& eq = context_.model.equations[static_cast<size_t>(r)];
+  const int connection = context_.jointOfRow[static_cast<size_t>(r)];
   const std::pair<int, int>* joint =
-      eq.source == EquationSource::Joint ? &context_.jointEnds[static_cast<size_t>(eq.element)] : nullptr;
+      connection >= 0 ? &context_.jointEnds[static_cast<size_t>(connection)] : nullptr;
   bool twoLinks = joint != nullptr && !parts.overflow;
   for (size_t s = 0; s < parts.used; ++s)
     twoLinks = twoLinks && (parts.perLink[s].first == joint->first || parts.perLink[s].first == joint->second);
@@ -292,7 +298,7 @@ void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
         parts.overflow ? std::numeric_limits<double>::infinity() : parts.perLink[s].second.squaredNorm();
     if (joint == nullptr)
       continue;
-    const int end = slotOf(l, eq.element);
+    const int end = slotOf(l, connection);
     if (end < 0)
       continue;
     const size_t at = static_cast<size_t>(l) * 2 + static_cast<size_t>(end);
@@ -305,7 +311,7 @@ void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
   }
   if (joint != nullptr && !twoLinks) {  // this connection's rows are not all rows of A on the end link
     for (int l : {joint->first, joint->second}) {
-      const int end = slotOf(l, eq.element);
+      const int end = slotOf(l, connection);
       if (end >= 0)
         endValid_[static_cast<size_t>(l) * 2 + static_cast<size_t>(end)] = 0;
     }
