@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "EquationGraph.hpp"
+#include "LocalRows.hpp"
 
 namespace mobility_analysis {
 
@@ -156,15 +157,12 @@ class Patches {
     std::sort(columns.begin(), columns.end(), std::greater<int>());
     for (size_t c = 0; c < columns.size(); ++c)
       columnMap_[columns[c]] = static_cast<int>(c);
-    triplets_.clear();
-    for (size_t i = 0; i < rows.size(); ++i) {
-      for (SparseJacobian::InnerIterator it(J_, rows[i]); it; ++it)
-        triplets_.emplace_back(static_cast<int>(i), columnMap_[it.col()], it.value());
-    }
+    SparseJacobian& local = local_;
+    core_detail::copyRows(
+        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local,
+        rowScratch_);
     for (int c : columns)
       columnMap_[c] = -1;
-    SparseJacobian local(static_cast<int>(rows.size()), static_cast<int>(columns.size()));
-    local.setFromTriplets(triplets_.begin(), triplets_.end());
 
     SparseElimination elimination(static_cast<int>(columns.size()), {}, tolerance_, true);
     for (int i = 0; i < local.rows(); ++i) {
@@ -189,7 +187,8 @@ class Patches {
   std::vector<int> distance_;
   std::vector<char> jointTaken_;
   std::vector<int> columnMap_;
-  std::vector<Eigen::Triplet<double>> triplets_;
+  SparseJacobian local_;  ///< The patch's rows, storage kept from patch to patch.
+  std::vector<std::pair<int, double>> rowScratch_;
 };
 
 }  // namespace

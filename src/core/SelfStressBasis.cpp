@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "EquationGraph.hpp"
+#include "LocalRows.hpp"
 
 namespace mobility_analysis {
 
@@ -259,7 +260,7 @@ class LocalStressFinder {
         }
         frontBegin = frontEnd;
       }
-      const std::vector<int> rows = collectRows(row);
+      const std::vector<int>& rows = collectRows(row);
       if (rows.size() > kLocalLimit) {
         break;
       }
@@ -336,9 +337,11 @@ class LocalStressFinder {
     }
   }
 
-  /// The ball's rows up to @p row, in sweep order.
-  std::vector<int> collectRows(int row) {
-    std::vector<int> rows, joints;
+  /// The ball's rows up to @p row, in sweep order (in a list kept from call to call).
+  const std::vector<int>& collectRows(int row) {
+    std::vector<int>& rows = ballRows_;
+    rows.clear();
+    joints_.clear();
     for (int link : ball_) {
       for (int r : graph_.linkRows[link]) {
         if (position_[r] < position_[row])
@@ -349,14 +352,14 @@ class LocalStressFinder {
         if (jointTaken_[j] != 0 || inBall_[joint.link1] == 0 || inBall_[joint.link2] == 0)
           continue;
         jointTaken_[j] = 1;
-        joints.push_back(j);
+        joints_.push_back(j);
         for (int r : graph_.jointRows[j]) {
           if (position_[r] <= position_[row])
             rows.push_back(r);
         }
       }
     }
-    for (int j : joints)
+    for (int j : joints_)
       jointTaken_[j] = 0;
     std::sort(rows.begin(), rows.end(), [&](int a, int b) { return position_[a] < position_[b]; });
     return rows;
@@ -365,7 +368,8 @@ class LocalStressFinder {
   /// The elimination of @p rows (the last one the row in question): its dependency, if it is dependent.
   std::optional<SelfStress> eliminate(const std::vector<int>& rows) {
     // The columns the rows touch, by sweep priority.
-    std::vector<int> columns;
+    std::vector<int>& columns = columns_;
+    columns.clear();
     for (int r : rows) {
       for (SparseJacobian::InnerIterator it(J_, r); it; ++it) {
         if (columnMap_[it.col()] < 0) {
@@ -378,16 +382,12 @@ class LocalStressFinder {
               [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
     for (size_t c = 0; c < columns.size(); ++c)
       columnMap_[columns[c]] = static_cast<int>(c);
-    std::vector<Eigen::Triplet<double>> triplets;
-    for (size_t i = 0; i < rows.size(); ++i) {
-      for (SparseJacobian::InnerIterator it(J_, rows[i]); it; ++it) {
-        triplets.emplace_back(static_cast<int>(i), columnMap_[it.col()], it.value());
-      }
-    }
+    SparseJacobian& local = local_;
+    core_detail::copyRows(
+        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local,
+        rowScratch_);
     for (int c : columns)
       columnMap_[c] = -1;
-    SparseJacobian local(static_cast<int>(rows.size()), static_cast<int>(columns.size()));
-    local.setFromTriplets(triplets.begin(), triplets.end());
 
     // Columns are sorted by sweep priority, so the local column index is the priority.
     SparseElimination elimination(static_cast<int>(columns.size()), {}, tolerance_, true);
@@ -415,6 +415,10 @@ class LocalStressFinder {
   std::vector<int> ball_;
   std::vector<char> inBall_, jointTaken_;
   std::vector<int> columnMap_;
+  // Kept from call to call (a braced lattice asks for one ball per redundant row): no allocation once warm.
+  std::vector<int> ballRows_, joints_, columns_;
+  SparseJacobian local_;
+  std::vector<std::pair<int, double>> rowScratch_;
   int lastRadius_ = 1;
   std::optional<EquationPlaces> places_;  ///< Built the first time a ball in space is needed.
   double spaceRadius_ = 0.0;
