@@ -10,6 +10,7 @@
 #include <coin/ClpSolve.hpp>
 #include <coin/CoinPackedMatrix.hpp>
 
+#include "../LocalMemo.hpp"
 #include "../LocalRows.hpp"
 
 namespace mobility_analysis {
@@ -158,6 +159,20 @@ class LonelyRowPeeler {
   std::vector<char> alive_;
 };
 
+/// What eliminating the kept rows of a ball gave, numbered by kept row (0 the seed): the states elsewhere in
+/// the ball (each pulls its own cables), in the order found, then the state through the seed, if any.
+struct BallOutcome {
+  std::vector<SelfStress> elsewhere;
+  std::optional<SelfStress> throughSeed;
+
+  size_t bytes() const {
+    size_t entries = throughSeed ? throughSeed->size() : 0;
+    for (const SelfStress& state : elsewhere)
+      entries += state.size();
+    return sizeof(BallOutcome) + entries * sizeof(SelfStress::value_type);
+  }
+};
+
 /// Workspace of localStressAround: marks sized once for the whole Jacobian (a stamp per ball instead of
 /// clearing them), and the ball's own lists, reused from ball to ball, so a ball costs what it holds (a
 /// braced lattice asks for one per cell).
@@ -168,7 +183,71 @@ struct BallWorkspace {
   LonelyRowPeeler peeler;
   SparseJacobian local;
   std::vector<std::pair<int, double>> rowScratch;
+  core_detail::LocalMemo<BallOutcome> memo;
 };
+
+/**
+ * Kept row k's dependency (it depends on the rows before it) as a state: multipliers y (y^T J = 0 for J as
+ * written), signed so that its cables are in tension, by kept row; nothing when it has no cable or pulls some
+ * cables and pushes others. A state through the seed (kept row 0) has y_seed = 1 and becomes
+ * outcome.throughSeed (returns true); one elsewhere in the ball is scaled to unit largest and added to
+ * outcome.elsewhere.
+ */
+bool readState(SparseElimination& elimination, int k, const std::vector<int>& keptRows,
+               const Eigen::VectorXd& rowNorm, const std::vector<char>& isCable, BallOutcome& outcome) {
+  const std::optional<SelfStress> dependency =
+      elimination.traceDependency(k, elimination.multipliers(), kMaxBallEquations);
+  if (!dependency)
+    return false;
+  double seedValue = 0.0, largest = 0.0;
+  for (const auto& [i, z] : *dependency) {
+    largest = std::max(largest, std::abs(z));
+    if (i == 0)
+      seedValue = z;
+  }
+  SelfStress stress;
+  stress.reserve(dependency->size());
+  int pulled = 0, pushed = 0;
+  for (const auto& [i, z] : *dependency) {
+    if (std::abs(z) <= kLocalNoise * largest)
+      continue;
+    const int row = keptRows[static_cast<size_t>(i)];
+    const double y = z / rowNorm(row);  // z refers to the scaled rows
+    if (isCable[static_cast<size_t>(row)])
+      (y > 0.0 ? pulled : pushed) += 1;
+    stress.emplace_back(i, y);
+  }
+  if ((pulled > 0) == (pushed > 0))
+    return false;
+  const bool throughSeed = std::abs(seedValue) > kSeedShare * largest;
+  double unit = pulled > 0 ? 1.0 : -1.0;
+  if (throughSeed)
+    unit = seedValue / rowNorm(keptRows[0]);
+  else
+    unit /= largest;
+  for (auto& entry : stress)
+    entry.second /= unit;
+  if (!throughSeed) {
+    outcome.elsewhere.push_back(std::move(stress));  // it tensions its own cables
+    return false;
+  }
+  outcome.throughSeed = std::move(stress);
+  return true;
+}
+
+/// Eliminates the kept rows of a ball afresh, in their order (@p local: row k is J's row keptRows[k]), and
+/// reads each dependent row's state (readState) until one passes through the seed.
+BallOutcome eliminateBall(const SparseJacobian& local, const std::vector<int>& keptRows,
+                          const Eigen::VectorXd& rowNorm, const std::vector<char>& isCable) {
+  BallOutcome outcome;
+  SparseElimination elimination(static_cast<int>(local.cols()), {}, kLocalRank, true);
+  for (int k = 0; k < static_cast<int>(local.rows()); ++k) {
+    if (elimination.addRow(local, k, 1.0 / rowNorm(keptRows[static_cast<size_t>(k)])).dependent &&
+        readState(elimination, k, keptRows, rowNorm, isCable, outcome))
+      break;
+  }
+  return outcome;
+}
 
 /**
  * A state of self-stress through cable row @p seed that puts no cable in compression, from the rows near
@@ -257,62 +336,45 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
     work.keptRows.resize(kept.size());
     for (size_t k = 0; k < kept.size(); ++k)
       work.keptRows[k] = ball[static_cast<size_t>(kept[k])];
-    const int numKept = static_cast<int>(kept.size());
     SparseJacobian& local = work.local;
     core_detail::copyRows(
         J, work.keptRows, [&](int column) { return work.columnLocal[column]; },
         static_cast<int>(columns.size()), local, work.rowScratch);
-    // A dependency of row i as multipliers (y^T J = 0 for J as written), signed so that its cables are in
-    // tension; nothing when it has no cable or pulls some cables and pushes others. A state through the
-    // seed has y_seed = 1.
-    auto stateOf = [&](SparseElimination& elimination, int i) -> std::optional<SelfStress> {
-      const std::optional<SelfStress> dependency =
-          elimination.traceDependency(i, elimination.multipliers(), kMaxBallEquations);
-      if (!dependency)
-        return std::nullopt;
-      double seedValue = 0.0, largest = 0.0;
-      for (const auto& [k, z] : *dependency) {
-        largest = std::max(largest, std::abs(z));
-        if (k == 0)
-          seedValue = z;
+    // The same ball elsewhere (a regular structure) gives the same outcome to the bit (LocalMemo): its
+    // elimination reads the local matrix and each kept row's norm and kind, nothing else.
+    core_detail::LocalMemo<BallOutcome>& memo = work.memo;
+    const BallOutcome* outcome = nullptr;
+    const bool keyed = memo.active();
+    if (keyed) {
+      memo.clearKey();
+      memo.appendKey(local);
+      for (int row : work.keptRows) {
+        memo.appendKey(rowNorm(row));
+        memo.appendKey(static_cast<uint64_t>(isCable[static_cast<size_t>(row)]));
       }
-      SelfStress stress;
-      stress.reserve(dependency->size());
-      int pulled = 0, pushed = 0;
-      for (const auto& [k, z] : *dependency) {
-        if (std::abs(z) <= kLocalNoise * largest)
-          continue;
-        const int row = ball[static_cast<size_t>(kept[static_cast<size_t>(k)])];
-        const double y = z / rowNorm(row);  // z refers to the scaled rows
-        if (isCable[static_cast<size_t>(row)])
-          (y > 0.0 ? pulled : pushed) += 1;
-        stress.emplace_back(row, y);
-      }
-      if ((pulled > 0) == (pushed > 0))
-        return std::nullopt;
-      const bool throughSeed = std::abs(seedValue) > kSeedShare * largest;
-      double unit = pulled > 0 ? 1.0 : -1.0;
-      if (throughSeed)
-        unit = seedValue / rowNorm(seed);
-      else
-        unit /= largest;
-      for (auto& entry : stress)
-        entry.second /= unit;
-      if (!throughSeed) {
-        found(stress);  // a state elsewhere in the ball: it tensions its own cables
-        return std::nullopt;
-      }
-      return stress;
-    };
-    SparseElimination elimination(static_cast<int>(columns.size()), {}, kLocalRank, true);
-    for (int k = 0; k < numKept; ++k) {
-      if (!elimination
-               .addRow(local, k, 1.0 / rowNorm(ball[static_cast<size_t>(kept[static_cast<size_t>(k)])]))
-               .dependent)
-        continue;
-      if (std::optional<SelfStress> stress = stateOf(elimination, k))
-        return stress;
+      outcome = memo.find();
     }
+    BallOutcome fresh;
+    if (!outcome) {
+      fresh = eliminateBall(local, work.keptRows, rowNorm, isCable);
+      outcome = &fresh;
+    }
+    auto inRows = [&](SelfStress state) {
+      for (auto& entry : state)
+        entry.first = work.keptRows[static_cast<size_t>(entry.first)];
+      return state;
+    };
+    for (const SelfStress& state : outcome->elsewhere)
+      found(inRows(state));
+    std::optional<SelfStress> result;
+    if (outcome->throughSeed)
+      result = inRows(*outcome->throughSeed);
+    if (keyed && outcome == &fresh) {
+      const size_t bytes = fresh.bytes();
+      memo.insert(std::move(fresh), bytes);
+    }
+    if (result)
+      return result;
   }
   return std::nullopt;
 }

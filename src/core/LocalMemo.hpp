@@ -1,0 +1,111 @@
+#pragma once
+
+// Private to src/core: the local stress searches (SelfStressBasis.cpp, ContractEchelon.cpp,
+// analysis/Prestress.cpp) remember the results of their small eliminations through it.
+
+#include <cstdint>
+#include <cstring>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "mobility_analysis/ConstraintJacobian.hpp"
+
+namespace mobility_analysis {
+namespace core_detail {
+
+/**
+ * Results of small local eliminations, looked up by everything the elimination reads, bit for bit.
+ *
+ * Why it is exact: a local elimination (SparseElimination on a local matrix, its rows in a given order,
+ * with given scales) is a deterministic function of those inputs, so two local problems whose inputs are
+ * equal to the last bit have equal results to the last bit, whatever part of the mechanism they come
+ * from; the caller stores its result in local numbering and maps it to its own rows. A key is compared in
+ * full (the hash only picks the bucket), never trusted by its hash. Why it pays: a regular structure (a
+ * lattice, a mast of equal bays) asks the same local question at every cell, whose matrix is the same
+ * where its coordinates differ by exactly representable steps (a 100 x 100 braced lattice: 1 500 distinct
+ * balls around 20 000 cables). Irregular structures never hit: past kMissesAlone lookups without a hit
+ * the memo stops keying, and it stores at most its byte budget.
+ */
+template <class Result>
+class LocalMemo {
+ public:
+  /// Lookups without a single hit after which keying stops.
+  static constexpr size_t kMissesAlone = 2000;
+
+  explicit LocalMemo(size_t byteBudget = size_t{64} << 20) : budget_(byteBudget) {}
+
+  /// Whether keys are still worth building.
+  bool active() const { return hits_ > 0 || lookups_ < kMissesAlone; }
+
+  /// Starts a key; the caller then appends every input of its elimination.
+  void clearKey() { key_.clear(); }
+  void appendKey(uint64_t word) { key_.push_back(word); }
+  void appendKey(double value) {
+    uint64_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    key_.push_back(bits);
+  }
+  /// The matrix's shape, pattern and values.
+  void appendKey(const SparseJacobian& local) {
+    appendKey(static_cast<uint64_t>(local.rows()));
+    appendKey(static_cast<uint64_t>(local.cols()));
+    for (Eigen::Index i = 0; i < local.rows(); ++i) {
+      appendKey(static_cast<uint64_t>(local.row(i).nonZeros()));
+      for (SparseJacobian::InnerIterator it(local, i); it; ++it) {
+        appendKey(static_cast<uint64_t>(it.col()));
+        appendKey(it.value());
+      }
+    }
+  }
+
+  /// The result stored under the current key, if any.
+  const Result* find() {
+    ++lookups_;
+    hash_ = hashOf(key_);
+    const auto bucket = table_.find(hash_);
+    if (bucket == table_.end())
+      return nullptr;
+    for (const Entry& entry : bucket->second) {
+      if (entry.key == key_) {
+        ++hits_;
+        return &entry.result;
+      }
+    }
+    return nullptr;
+  }
+
+  /// Stores @p result under the key of the last find (while within the byte budget).
+  void insert(Result result, size_t resultBytes) {
+    const size_t bytes = key_.size() * sizeof(uint64_t) + resultBytes;
+    if (stored_ + bytes > budget_)
+      return;
+    stored_ += bytes;
+    table_[hash_].push_back(Entry{key_, std::move(result)});
+  }
+
+ private:
+  struct Entry {
+    std::vector<uint64_t> key;
+    Result result;
+  };
+
+  static uint64_t hashOf(const std::vector<uint64_t>& words) {
+    uint64_t h = 1469598103934665603ull;  // FNV-1a over the words, mixed
+    for (uint64_t w : words) {
+      h ^= w + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+      h *= 1099511628211ull;
+    }
+    return h;
+  }
+
+  size_t budget_;
+  size_t stored_ = 0;
+  size_t lookups_ = 0, hits_ = 0;
+  uint64_t hash_ = 0;
+  std::vector<uint64_t> key_;
+  std::unordered_map<uint64_t, std::vector<Entry>> table_;
+};
+
+}  // namespace core_detail
+}  // namespace mobility_analysis
