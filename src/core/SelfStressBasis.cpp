@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "EquationGraph.hpp"
+#include "LocalMemo.hpp"
 #include "LocalRows.hpp"
 
 namespace mobility_analysis {
@@ -389,8 +390,35 @@ class LocalStressFinder {
     for (int c : columns)
       columnMap_[c] = -1;
 
+    // The same local problem elsewhere (a regular structure) has the same dependency to the bit
+    // (LocalMemo): the elimination reads the local matrix and nothing else.
+    std::optional<SelfStress> stress;
+    const bool keyed = memo_.active();
+    const std::optional<SelfStress>* known = nullptr;
+    if (keyed) {
+      memo_.clearKey();
+      memo_.appendKey(local);
+      known = memo_.find();
+    }
+    if (known) {
+      stress = *known;
+    } else {
+      stress = lastDependency(local);
+      if (keyed)
+        memo_.insert(stress, sizeof(stress) + (stress ? stress->size() * sizeof(SelfStress::value_type) : 0));
+    }
+    if (!stress)
+      return std::nullopt;
+    for (auto& entry : *stress)
+      entry.first = rows[entry.first];
+    std::sort(stress->begin(), stress->end());
+    return stress;
+  }
+
+  /// The dependency of @p local's last row on the rows before it (local row numbers), if it is dependent.
+  std::optional<SelfStress> lastDependency(const SparseJacobian& local) const {
     // Columns are sorted by sweep priority, so the local column index is the priority.
-    SparseElimination elimination(static_cast<int>(columns.size()), {}, tolerance_, true);
+    SparseElimination elimination(static_cast<int>(local.cols()), {}, tolerance_, true);
     SparseElimination::Step step;
     for (int i = 0; i < local.rows(); ++i) {
       const double norm = local.row(i).norm();
@@ -398,11 +426,7 @@ class LocalStressFinder {
     }
     if (!step.dependent)
       return std::nullopt;
-    SelfStress stress = *elimination.traceDependency(local.rows() - 1, elimination.multipliers());
-    for (auto& entry : stress)
-      entry.first = rows[entry.first];
-    std::sort(stress.begin(), stress.end());
-    return stress;
+    return elimination.traceDependency(static_cast<int>(local.rows()) - 1, elimination.multipliers());
   }
 
   const Mechanism& mechanism_;
@@ -419,6 +443,7 @@ class LocalStressFinder {
   std::vector<int> ballRows_, joints_, columns_;
   SparseJacobian local_;
   std::vector<std::pair<int, double>> rowScratch_;
+  core_detail::LocalMemo<std::optional<SelfStress>> memo_;
   int lastRadius_ = 1;
   std::optional<EquationPlaces> places_;  ///< Built the first time a ball in space is needed.
   double spaceRadius_ = 0.0;
