@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "EquationGraph.hpp"
+#include "LocalMemo.hpp"
 #include "LocalRows.hpp"
 
 namespace mobility_analysis {
@@ -164,7 +165,74 @@ class Patches {
     for (int c : columns)
       columnMap_[c] = -1;
 
-    SparseElimination elimination(static_cast<int>(columns.size()), {}, tolerance_, true);
+    // The same patch elsewhere (a regular structure) has the same dependencies to the bit (LocalMemo): the
+    // elimination reads the local matrix and nothing else. Only then is every dependent row traced, wanted
+    // or not, so that the outcome serves a later patch whatever it wants.
+    const bool keyed = memo_.active();
+    const PatchOutcome* known = nullptr;
+    if (keyed) {
+      memo_.clearKey();
+      memo_.appendKey(local);
+      known = memo_.find();
+    }
+    if (!keyed) {
+      eliminateWanted(local, rows, wanted, found);
+      return;
+    }
+    PatchOutcome fresh;
+    if (!known) {
+      fresh = eliminateAll(local);
+      known = &fresh;
+    }
+    for (const auto& [i, dependency] : known->dependencies) {
+      if (!wanted(rows[i]))
+        continue;
+      SelfStress stress = dependency;
+      for (auto& entry : stress)
+        entry.first = rows[entry.first];
+      found(rows[i], std::move(stress));
+    }
+    storedEntries += known->storedEntries;
+    if (known == &fresh) {
+      const size_t bytes = fresh.bytes();
+      memo_.insert(std::move(fresh), bytes);
+    }
+  }
+
+  size_t storedEntries = 0;
+
+ private:
+  /// What eliminating a patch gave: each dependent row (local number) with its dependency (local rows).
+  struct PatchOutcome {
+    std::vector<std::pair<int, SelfStress>> dependencies;
+    size_t storedEntries = 0;
+
+    size_t bytes() const {
+      size_t bytes = sizeof(PatchOutcome);
+      for (const auto& dependency : dependencies)
+        bytes += sizeof(dependency) + dependency.second.size() * sizeof(SelfStress::value_type);
+      return bytes;
+    }
+  };
+
+  /// @p local's rows eliminated in order, every dependent row traced.
+  PatchOutcome eliminateAll(const SparseJacobian& local) const {
+    PatchOutcome outcome;
+    SparseElimination elimination(static_cast<int>(local.cols()), {}, tolerance_, true);
+    for (int i = 0; i < local.rows(); ++i) {
+      const double norm = local.row(i).norm();
+      if (elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0).dependent)
+        outcome.dependencies.emplace_back(i, *elimination.traceDependency(i, elimination.multipliers()));
+    }
+    outcome.storedEntries = elimination.storedEntries();
+    return outcome;
+  }
+
+  /// @p local's rows eliminated in order, only the dependent rows that @p wanted accepts traced.
+  template <class Wanted, class Found>
+  void eliminateWanted(const SparseJacobian& local, const std::vector<int>& rows, Wanted&& wanted,
+                       Found&& found) {
+    SparseElimination elimination(static_cast<int>(local.cols()), {}, tolerance_, true);
     for (int i = 0; i < local.rows(); ++i) {
       const double norm = local.row(i).norm();
       if (!elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0).dependent || !wanted(rows[i]))
@@ -177,9 +245,6 @@ class Patches {
     storedEntries += elimination.storedEntries();
   }
 
-  size_t storedEntries = 0;
-
- private:
   const Mechanism& mechanism_;
   const SparseJacobian& J_;
   const core_detail::EquationGraph& graph_;
@@ -188,6 +253,7 @@ class Patches {
   std::vector<char> jointTaken_;
   std::vector<int> columnMap_;
   SparseJacobian local_;  ///< The patch's rows, storage kept from patch to patch.
+  core_detail::LocalMemo<PatchOutcome> memo_;
   std::vector<std::pair<int, double>> rowScratch_;
 };
 

@@ -35,8 +35,16 @@ class LocalMemo {
 
   explicit LocalMemo(size_t byteBudget = size_t{64} << 20) : budget_(byteBudget) {}
 
-  /// Whether keys are still worth building.
-  bool active() const { return hits_ > 0 || lookups_ < kMissesAlone; }
+  /// Whether keys are still worth building; once not, what was stored is released.
+  bool active() {
+    if (hits_ > 0 || lookups_ < kMissesAlone)
+      return true;
+    if (!table_.empty()) {
+      table_ = {};
+      stored_ = budget_;  // nothing more is stored
+    }
+    return false;
+  }
 
   /// Starts a key; the caller then appends every input of its elimination.
   void clearKey() { key_.clear(); }
