@@ -54,17 +54,22 @@ class LocalMemo {
     std::memcpy(&bits, &value, sizeof bits);
     key_.push_back(bits);
   }
-  /// The matrix's shape, pattern and values.
+  /// The matrix's shape, pattern and values (compressed storage, as copyRows writes it, copied in bulk:
+  /// the key of a hit costs a small part of the elimination it saves).
   void appendKey(const SparseJacobian& local) {
-    appendKey(static_cast<uint64_t>(local.rows()));
+    const Eigen::Index rows = local.rows();
+    const Eigen::Index entries = local.outerIndexPtr()[rows] - local.outerIndexPtr()[0];
+    appendKey(static_cast<uint64_t>(rows));
     appendKey(static_cast<uint64_t>(local.cols()));
-    for (Eigen::Index i = 0; i < local.rows(); ++i) {
-      appendKey(static_cast<uint64_t>(local.row(i).nonZeros()));
-      for (SparseJacobian::InnerIterator it(local, i); it; ++it) {
-        appendKey(static_cast<uint64_t>(it.col()));
-        appendKey(it.value());
-      }
-    }
+    const size_t start = key_.size();
+    // Row starts and column indices two to a word, then the values' bits.
+    const size_t indexWords = (static_cast<size_t>(rows + 1 + entries) + 1) / 2;
+    key_.resize(start + indexWords + static_cast<size_t>(entries), 0);
+    std::memcpy(key_.data() + start, local.outerIndexPtr(), static_cast<size_t>(rows + 1) * sizeof(int));
+    std::memcpy(reinterpret_cast<int*>(key_.data() + start) + rows + 1,
+                local.innerIndexPtr() + local.outerIndexPtr()[0], static_cast<size_t>(entries) * sizeof(int));
+    std::memcpy(key_.data() + start + indexWords, local.valuePtr() + local.outerIndexPtr()[0],
+                static_cast<size_t>(entries) * sizeof(double));
   }
 
   /// The result stored under the current key, if any.
@@ -98,10 +103,11 @@ class LocalMemo {
     Result result;
   };
 
+  /// Picks the bucket only (keys are compared in full), so every fourth word and the length suffice.
   static uint64_t hashOf(const std::vector<uint64_t>& words) {
-    uint64_t h = 1469598103934665603ull;  // FNV-1a over the words, mixed
-    for (uint64_t w : words) {
-      h ^= w + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    uint64_t h = 1469598103934665603ull ^ words.size();
+    for (size_t i = 0; i < words.size(); i += 4) {
+      h ^= words[i] + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
       h *= 1099511628211ull;
     }
     return h;
