@@ -166,25 +166,34 @@ class Patches {
       columnMap_[c] = -1;
 
     // The same patch elsewhere (a regular structure) has the same dependencies to the bit (LocalMemo): the
-    // elimination reads the local matrix and nothing else. Only then is every dependent row traced, wanted
-    // or not, so that the outcome serves a later patch whatever it wants.
-    const bool keyed = memo_.active();
-    const PatchOutcome* known = nullptr;
-    if (keyed) {
+    // elimination reads the local matrix and nothing else. What a patch wants is fixed before it is
+    // eliminated (found sets the proof of its own row only), so a known patch serves when it holds the
+    // dependency of every row wanted now; otherwise the patch is eliminated again, tracing what is wanted
+    // now and what was traced before, and that outcome replaces the known one.
+    PatchOutcome* known = nullptr;
+    if (memo_.active()) {
       memo_.clearKey();
       memo_.appendKey(local);
       known = memo_.find();
-    }
-    if (!keyed) {
+    } else {
       eliminateWanted(local, rows, wanted, found);
       return;
     }
+    const bool serves =
+        known && std::all_of(known->dependencies.begin(), known->dependencies.end(),
+                             [&](const auto& d) { return !d.second.empty() || !wanted(rows[d.first]); });
     PatchOutcome fresh;
-    if (!known) {
-      fresh = eliminateAll(local);
-      known = &fresh;
+    if (!serves) {
+      std::vector<char> traced(static_cast<size_t>(local.rows()), 0);
+      if (known) {
+        for (const auto& [i, dependency] : known->dependencies)
+          traced[static_cast<size_t>(i)] = dependency.empty() ? 0 : 1;
+      }
+      fresh = eliminateTracing(local,
+                               [&](int i) { return traced[static_cast<size_t>(i)] != 0 || wanted(rows[i]); });
     }
-    for (const auto& [i, dependency] : known->dependencies) {
+    const PatchOutcome& outcome = serves ? *known : fresh;
+    for (const auto& [i, dependency] : outcome.dependencies) {
       if (!wanted(rows[i]))
         continue;
       SelfStress stress = dependency;
@@ -192,8 +201,10 @@ class Patches {
         entry.first = rows[entry.first];
       found(rows[i], std::move(stress));
     }
-    storedEntries += known->storedEntries;
-    if (known == &fresh) {
+    storedEntries += outcome.storedEntries;
+    if (known && !serves) {
+      *known = std::move(fresh);
+    } else if (!known) {
       const size_t bytes = fresh.bytes();
       memo_.insert(std::move(fresh), bytes);
     }
@@ -202,7 +213,8 @@ class Patches {
   size_t storedEntries = 0;
 
  private:
-  /// What eliminating a patch gave: each dependent row (local number) with its dependency (local rows).
+  /// What eliminating a patch gave: each dependent row (local number) with its dependency (local rows), or
+  /// nothing (empty) where it was not traced.
   struct PatchOutcome {
     std::vector<std::pair<int, SelfStress>> dependencies;
     size_t storedEntries = 0;
@@ -215,14 +227,17 @@ class Patches {
     }
   };
 
-  /// @p local's rows eliminated in order, every dependent row traced.
-  PatchOutcome eliminateAll(const SparseJacobian& local) const {
+  /// @p local's rows eliminated in order, the dependent rows that @p traced accepts traced.
+  template <class Traced>
+  PatchOutcome eliminateTracing(const SparseJacobian& local, Traced&& traced) const {
     PatchOutcome outcome;
     SparseElimination elimination(static_cast<int>(local.cols()), {}, tolerance_, true);
     for (int i = 0; i < local.rows(); ++i) {
       const double norm = local.row(i).norm();
-      if (elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0).dependent)
-        outcome.dependencies.emplace_back(i, *elimination.traceDependency(i, elimination.multipliers()));
+      if (!elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0).dependent)
+        continue;
+      outcome.dependencies.emplace_back(
+          i, traced(i) ? *elimination.traceDependency(i, elimination.multipliers()) : SelfStress{});
     }
     outcome.storedEntries = elimination.storedEntries();
     return outcome;

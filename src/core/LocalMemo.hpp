@@ -54,6 +54,12 @@ class LocalMemo {
     std::memcpy(&bits, &value, sizeof bits);
     key_.push_back(bits);
   }
+  /// @p count integers, two to a word.
+  void appendKey(const int* data, size_t count) {
+    const size_t start = key_.size();
+    key_.resize(start + (count + 1) / 2, 0);
+    std::memcpy(key_.data() + start, data, count * sizeof(int));
+  }
   /// The matrix's shape, pattern and values (compressed storage, as copyRows writes it, copied in bulk:
   /// the key of a hit costs a small part of the elimination it saves).
   void appendKey(const SparseJacobian& local) {
@@ -72,14 +78,14 @@ class LocalMemo {
                 static_cast<size_t>(entries) * sizeof(double));
   }
 
-  /// The result stored under the current key, if any.
-  const Result* find() {
+  /// The result stored under the current key, if any (the caller may improve it in place).
+  Result* find() {
     ++lookups_;
     hash_ = hashOf(key_);
     const auto bucket = table_.find(hash_);
     if (bucket == table_.end())
       return nullptr;
-    for (const Entry& entry : bucket->second) {
+    for (Entry& entry : bucket->second) {
       if (entry.key == key_) {
         ++hits_;
         return &entry.result;

@@ -184,6 +184,7 @@ struct BallWorkspace {
   SparseJacobian local;
   std::vector<std::pair<int, double>> rowScratch;
   core_detail::LocalMemo<BallOutcome> memo;
+  core_detail::LocalMemo<std::vector<char>> peelMemo;
 };
 
 /**
@@ -247,6 +248,23 @@ BallOutcome eliminateBall(const SparseJacobian& local, const std::vector<int>& k
       break;
   }
   return outcome;
+}
+
+/// The ball's rows that can carry a state (LonelyRowPeeler), known from an equal pattern where there was one.
+const std::vector<char>& peel(BallWorkspace& work, int numRows, size_t numColumns) {
+  core_detail::LocalMemo<std::vector<char>>& memo = work.peelMemo;
+  if (!memo.active())
+    return work.peeler.peel(work.entryColumn, work.rowStart, numRows, numColumns);
+  memo.clearKey();
+  memo.appendKey(static_cast<uint64_t>(numRows));
+  memo.appendKey(static_cast<uint64_t>(numColumns));
+  memo.appendKey(work.rowStart.data(), work.rowStart.size());
+  memo.appendKey(work.entryColumn.data(), work.entryColumn.size());
+  if (const std::vector<char>* known = memo.find())
+    return *known;
+  const std::vector<char>& alive = work.peeler.peel(work.entryColumn, work.rowStart, numRows, numColumns);
+  memo.insert(alive, alive.size());
+  return alive;
 }
 
 /**
@@ -318,8 +336,9 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
     rowStart.push_back(static_cast<int>(entryColumn.size()));  // end of the last row, popped below
     if (static_cast<int>(columns.size()) > kMaxBallColumns)
       return std::nullopt;
-    // Peel the rows that cannot carry a state; what stays is where the ball's states can be.
-    const std::vector<char>& alive = work.peeler.peel(entryColumn, rowStart, numRows, columns.size());
+    // Peel the rows that cannot carry a state; what stays is where the ball's states can be. The peeling
+    // reads the ball's pattern only, so the same pattern elsewhere peels the same (LocalMemo).
+    const std::vector<char>& alive = peel(work, numRows, columns.size());
     rowStart.pop_back();
     if (!alive[0])
       continue;  // no state through the seed yet
