@@ -210,7 +210,21 @@ class LocalStressFinder {
         graph_(mechanism, model),
         inBall_(mechanism.links.size(), 0),
         jointTaken_(mechanism.joints.size(), 0),
-        columnMap_(J.cols(), -1) {}
+        columnMap_(J.cols(), -1) {
+    // Where the priorities are a permutation (the sweep numbers every coordinate once), a ball's columns are
+    // put in priority order by sorting their priorities and reading the columns back: the same order as
+    // sorting the columns by priority, without the indirection.
+    std::vector<int> columnOf(order.columnPriority.size(), -1);
+    bool permutation = true;
+    for (size_t c = 0; c < order.columnPriority.size() && permutation; ++c) {
+      const int p = order.columnPriority[c];
+      permutation = p >= 0 && p < static_cast<int>(columnOf.size()) && columnOf[static_cast<size_t>(p)] < 0;
+      if (permutation)
+        columnOf[static_cast<size_t>(p)] = static_cast<int>(c);
+    }
+    if (permutation)
+      columnOfPriority_ = std::move(columnOf);
+  }
 
   /// Whether the ball in space is tried first (it found shorter stresses than the links' ball).
   bool inSpaceFirst() const { return inSpaceFirst_; }
@@ -379,8 +393,16 @@ class LocalStressFinder {
         }
       }
     }
-    std::sort(columns.begin(), columns.end(),
-              [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
+    if (!columnOfPriority_.empty()) {
+      for (int& c : columns)
+        c = order_.columnPriority[c];
+      std::sort(columns.begin(), columns.end());
+      for (int& c : columns)
+        c = columnOfPriority_[static_cast<size_t>(c)];
+    } else {
+      std::sort(columns.begin(), columns.end(),
+                [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
+    }
     for (size_t c = 0; c < columns.size(); ++c)
       columnMap_[columns[c]] = static_cast<int>(c);
     SparseJacobian& local = local_;
@@ -441,6 +463,7 @@ class LocalStressFinder {
   std::vector<int> columnMap_;
   // Kept from call to call (a braced lattice asks for one ball per redundant row): no allocation once warm.
   std::vector<int> ballRows_, joints_, columns_;
+  std::vector<int> columnOfPriority_;  ///< Inverse of order_.columnPriority where that is a permutation.
   SparseJacobian local_;
   std::vector<std::pair<int, double>> rowScratch_;
   core_detail::LocalMemo<std::optional<SelfStress>> memo_;
