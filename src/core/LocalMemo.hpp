@@ -31,7 +31,7 @@ template <class Result>
 class LocalMemo {
  public:
   /// Lookups without a single hit after which keying stops.
-  static constexpr size_t kMissesAlone = 2000;
+  static constexpr size_t kMissesAlone = 500;
 
   explicit LocalMemo(size_t byteBudget = size_t{64} << 20) : budget_(byteBudget) {}
 

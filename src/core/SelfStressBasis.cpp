@@ -210,21 +210,7 @@ class LocalStressFinder {
         graph_(mechanism, model),
         inBall_(mechanism.links.size(), 0),
         jointTaken_(mechanism.joints.size(), 0),
-        columnMap_(J.cols(), -1) {
-    // Where the priorities are a permutation (the sweep numbers every coordinate once), a ball's columns are
-    // put in priority order by sorting their priorities and reading the columns back: the same order as
-    // sorting the columns by priority, without the indirection.
-    std::vector<int> columnOf(order.columnPriority.size(), -1);
-    bool permutation = true;
-    for (size_t c = 0; c < order.columnPriority.size() && permutation; ++c) {
-      const int p = order.columnPriority[c];
-      permutation = p >= 0 && p < static_cast<int>(columnOf.size()) && columnOf[static_cast<size_t>(p)] < 0;
-      if (permutation)
-        columnOf[static_cast<size_t>(p)] = static_cast<int>(c);
-    }
-    if (permutation)
-      columnOfPriority_ = std::move(columnOf);
-  }
+        columnMap_(J.cols(), -1) {}
 
   /// Whether the ball in space is tried first (it found shorter stresses than the links' ball).
   bool inSpaceFirst() const { return inSpaceFirst_; }
@@ -393,6 +379,10 @@ class LocalStressFinder {
         }
       }
     }
+    if (!inverseTried_) {
+      buildColumnOfPriority();
+      inverseTried_ = true;
+    }
     if (!columnOfPriority_.empty()) {
       for (int& c : columns)
         c = order_.columnPriority[c];
@@ -437,6 +427,20 @@ class LocalStressFinder {
     return stress;
   }
 
+  /// Where the priorities are a permutation (the sweep numbers every coordinate once), a ball's columns are
+  /// put in priority order by sorting their priorities and reading the columns back: the same order as
+  /// sorting the columns by priority, without the indirection. Built at the first ball only.
+  void buildColumnOfPriority() {
+    std::vector<int> columnOf(order_.columnPriority.size(), -1);
+    for (size_t c = 0; c < order_.columnPriority.size(); ++c) {
+      const int p = order_.columnPriority[c];
+      if (p < 0 || p >= static_cast<int>(columnOf.size()) || columnOf[static_cast<size_t>(p)] >= 0)
+        return;  // not a permutation: the indirect sort
+      columnOf[static_cast<size_t>(p)] = static_cast<int>(c);
+    }
+    columnOfPriority_ = std::move(columnOf);
+  }
+
   /// The dependency of @p local's last row on the rows before it (local row numbers), if it is dependent.
   std::optional<SelfStress> lastDependency(const SparseJacobian& local) const {
     // Columns are sorted by sweep priority, so the local column index is the priority.
@@ -464,6 +468,7 @@ class LocalStressFinder {
   // Kept from call to call (a braced lattice asks for one ball per redundant row): no allocation once warm.
   std::vector<int> ballRows_, joints_, columns_;
   std::vector<int> columnOfPriority_;  ///< Inverse of order_.columnPriority where that is a permutation.
+  bool inverseTried_ = false;
   SparseJacobian local_;
   std::vector<std::pair<int, double>> rowScratch_;
   core_detail::LocalMemo<std::optional<SelfStress>> memo_;
