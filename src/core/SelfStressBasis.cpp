@@ -8,6 +8,8 @@
 #include <unordered_map>
 
 #include "EquationGraph.hpp"
+#include "LocalMemo.hpp"
+#include "LocalRows.hpp"
 
 namespace mobility_analysis {
 
@@ -261,7 +263,7 @@ class LocalStressFinder {
         }
         frontBegin = frontEnd;
       }
-      const std::vector<int> rows = collectRows(row);
+      const std::vector<int>& rows = collectRows(row);
       if (rows.size() > kLocalLimit) {
         break;
       }
@@ -338,9 +340,11 @@ class LocalStressFinder {
     }
   }
 
-  /// The ball's rows up to @p row, in sweep order.
-  std::vector<int> collectRows(int row) {
-    std::vector<int> rows, joints;
+  /// The ball's rows up to @p row, in sweep order (in a list kept from call to call).
+  const std::vector<int>& collectRows(int row) {
+    std::vector<int>& rows = ballRows_;
+    rows.clear();
+    joints_.clear();
     for (int link : ball_) {
       for (int r : graph_.linkRows[link]) {
         if (position_[r] < position_[row])
@@ -351,14 +355,14 @@ class LocalStressFinder {
         if (jointTaken_[j] != 0 || inBall_[joint.link1] == 0 || inBall_[joint.link2] == 0)
           continue;
         jointTaken_[j] = 1;
-        joints.push_back(j);
+        joints_.push_back(j);
         for (int r : graph_.jointRows[j]) {
           if (position_[r] <= position_[row])
             rows.push_back(r);
         }
       }
     }
-    for (int j : joints)
+    for (int j : joints_)
       jointTaken_[j] = 0;
     std::sort(rows.begin(), rows.end(), [&](int a, int b) { return position_[a] < position_[b]; });
     return rows;
@@ -367,7 +371,8 @@ class LocalStressFinder {
   /// The elimination of @p rows (the last one the row in question): its dependency, if it is dependent.
   std::optional<SelfStress> eliminate(const std::vector<int>& rows) {
     // The columns the rows touch, by sweep priority.
-    std::vector<int> columns;
+    std::vector<int>& columns = columns_;
+    columns.clear();
     for (int r : rows) {
       for (SparseJacobian::InnerIterator it(J_, r); it; ++it) {
         if (columnMap_[it.col()] < 0) {
@@ -376,23 +381,72 @@ class LocalStressFinder {
         }
       }
     }
-    std::sort(columns.begin(), columns.end(),
-              [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
+    if (!inverseTried_) {
+      buildColumnOfPriority();
+      inverseTried_ = true;
+    }
+    if (!columnOfPriority_.empty()) {
+      for (int& c : columns)
+        c = order_.columnPriority[c];
+      std::sort(columns.begin(), columns.end());
+      for (int& c : columns)
+        c = columnOfPriority_[static_cast<size_t>(c)];
+    } else {
+      std::sort(columns.begin(), columns.end(),
+                [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
+    }
     for (size_t c = 0; c < columns.size(); ++c)
       columnMap_[columns[c]] = static_cast<int>(c);
-    std::vector<Eigen::Triplet<double>> triplets;
-    for (size_t i = 0; i < rows.size(); ++i) {
-      for (SparseJacobian::InnerIterator it(J_, rows[i]); it; ++it) {
-        triplets.emplace_back(static_cast<int>(i), columnMap_[it.col()], it.value());
-      }
-    }
+    SparseJacobian& local = local_;
+    core_detail::copyRows(
+        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local,
+        rowScratch_);
     for (int c : columns)
       columnMap_[c] = -1;
-    SparseJacobian local(static_cast<int>(rows.size()), static_cast<int>(columns.size()));
-    local.setFromTriplets(triplets.begin(), triplets.end());
 
+    // The same local problem elsewhere (a regular structure) has the same dependency to the bit
+    // (LocalMemo): the elimination reads the local matrix and nothing else.
+    std::optional<SelfStress> stress;
+    const bool keyed = memo_.active();
+    const std::optional<SelfStress>* known = nullptr;
+    if (keyed) {
+      memo_.clearKey();
+      memo_.appendKey(local);
+      known = memo_.find();
+    }
+    if (known) {
+      stress = *known;
+    } else {
+      stress = lastDependency(local);
+      if (keyed)
+        memo_.insert(stress, sizeof(stress) + (stress ? stress->size() * sizeof(SelfStress::value_type) : 0));
+    }
+    if (!stress)
+      return std::nullopt;
+    for (auto& entry : *stress)
+      entry.first = rows[entry.first];
+    std::sort(stress->begin(), stress->end());
+    return stress;
+  }
+
+  /// Where the priorities are a permutation (the sweep numbers every coordinate once), a ball's columns are
+  /// put in priority order by sorting their priorities and reading the columns back: the same order as
+  /// sorting the columns by priority, without the indirection. Built at the first ball only.
+  void buildColumnOfPriority() {
+    std::vector<int> columnOf(order_.columnPriority.size(), -1);
+    for (size_t c = 0; c < order_.columnPriority.size(); ++c) {
+      const int p = order_.columnPriority[c];
+      if (p < 0 || p >= static_cast<int>(columnOf.size()) || columnOf[static_cast<size_t>(p)] >= 0)
+        return;  // not a permutation: the indirect sort
+      columnOf[static_cast<size_t>(p)] = static_cast<int>(c);
+    }
+    columnOfPriority_ = std::move(columnOf);
+  }
+
+  /// The dependency of @p local's last row on the rows before it (local row numbers), if it is dependent.
+  std::optional<SelfStress> lastDependency(const SparseJacobian& local) const {
     // Columns are sorted by sweep priority, so the local column index is the priority.
-    SparseElimination elimination(static_cast<int>(columns.size()), {}, tolerance_, true);
+    SparseElimination elimination(static_cast<int>(local.cols()), {}, tolerance_, true);
     SparseElimination::Step step;
     for (int i = 0; i < local.rows(); ++i) {
       const double norm = local.row(i).norm();
@@ -400,11 +454,7 @@ class LocalStressFinder {
     }
     if (!step.dependent)
       return std::nullopt;
-    SelfStress stress = *elimination.traceDependency(local.rows() - 1, elimination.multipliers());
-    for (auto& entry : stress)
-      entry.first = rows[entry.first];
-    std::sort(stress.begin(), stress.end());
-    return stress;
+    return elimination.traceDependency(static_cast<int>(local.rows()) - 1, elimination.multipliers());
   }
 
   const Mechanism& mechanism_;
@@ -417,6 +467,13 @@ class LocalStressFinder {
   std::vector<int> ball_;
   std::vector<char> inBall_, jointTaken_;
   std::vector<int> columnMap_;
+  // Kept from call to call (a braced lattice asks for one ball per redundant row): no allocation once warm.
+  std::vector<int> ballRows_, joints_, columns_;
+  std::vector<int> columnOfPriority_;  ///< Inverse of order_.columnPriority where that is a permutation.
+  bool inverseTried_ = false;
+  SparseJacobian local_;
+  std::vector<std::pair<int, double>> rowScratch_;
+  core_detail::LocalMemo<std::optional<SelfStress>> memo_;
   int lastRadius_ = 1;
   std::optional<EquationPlaces> places_;  ///< Built the first time a ball in space is needed.
   double spaceRadius_ = 0.0;

@@ -10,6 +10,9 @@
 #include <coin/ClpSolve.hpp>
 #include <coin/CoinPackedMatrix.hpp>
 
+#include "../LocalMemo.hpp"
+#include "../LocalRows.hpp"
+
 namespace mobility_analysis {
 
 namespace {
@@ -103,50 +106,164 @@ CablePrestress solvePrestressProgram(const std::vector<SelfStress>& states, int 
   return result;
 }
 
-/// Workspace of localStressAround, sized once for the whole Jacobian.
+/// The rows of a ball that can carry a state: a row alone on one of its coordinates (within the ball) has
+/// multiplier 0 in every state of the ball, so it goes, and so on inwards. What stays is the largest set of
+/// rows with no coordinate held by exactly one of them (the union of two such sets is one), whatever the
+/// order of peeling. Workspaces are kept from ball to ball.
+class LonelyRowPeeler {
+ public:
+  /// Row i's entries are entryColumn[rowStart[i] .. rowStart[i + 1]) (rowStart has one entry past the last
+  /// row), columns below @p numColumns. Returns 1 for each row that stays.
+  const std::vector<char>& peel(const std::vector<int>& entryColumn, const std::vector<int>& rowStart,
+                                int numRows, size_t numColumns) {
+    count_.assign(numColumns, 0);
+    for (int c : entryColumn)
+      ++count_[static_cast<size_t>(c)];
+    columnStart_.assign(numColumns + 1, 0);
+    for (size_t c = 0; c < numColumns; ++c)
+      columnStart_[c + 1] = columnStart_[c] + count_[c];
+    columnRows_.resize(entryColumn.size());
+    fill_.assign(columnStart_.begin(), columnStart_.end() - 1);
+    for (int i = 0; i < numRows; ++i) {
+      for (int e = rowStart[static_cast<size_t>(i)]; e < rowStart[static_cast<size_t>(i) + 1]; ++e)
+        columnRows_[static_cast<size_t>(fill_[static_cast<size_t>(entryColumn[static_cast<size_t>(e)])]++)] =
+            i;
+    }
+    alive_.assign(static_cast<size_t>(numRows), 1);
+    lonely_.clear();
+    for (size_t c = 0; c < numColumns; ++c) {
+      if (count_[c] == 1)
+        lonely_.push_back(columnRows_[static_cast<size_t>(columnStart_[c])]);
+    }
+    while (!lonely_.empty()) {
+      const int i = lonely_.back();
+      lonely_.pop_back();
+      if (!alive_[static_cast<size_t>(i)])
+        continue;
+      alive_[static_cast<size_t>(i)] = 0;
+      for (int e = rowStart[static_cast<size_t>(i)]; e < rowStart[static_cast<size_t>(i) + 1]; ++e) {
+        const size_t c = static_cast<size_t>(entryColumn[static_cast<size_t>(e)]);
+        if (--count_[c] != 1)
+          continue;
+        for (int k = columnStart_[c]; k < columnStart_[c + 1]; ++k) {
+          if (alive_[static_cast<size_t>(columnRows_[static_cast<size_t>(k)])])
+            lonely_.push_back(columnRows_[static_cast<size_t>(k)]);
+        }
+      }
+    }
+    return alive_;
+  }
+
+ private:
+  std::vector<int> count_, columnStart_, columnRows_, fill_, lonely_;
+  std::vector<char> alive_;
+};
+
+/// What eliminating the kept rows of a ball gave, numbered by kept row (0 the seed): the states elsewhere in
+/// the ball (each pulls its own cables), in the order found, then the state through the seed, if any.
+struct BallOutcome {
+  std::vector<SelfStress> elsewhere;
+  std::optional<SelfStress> throughSeed;
+
+  size_t bytes() const {
+    size_t entries = throughSeed ? throughSeed->size() : 0;
+    for (const SelfStress& state : elsewhere)
+      entries += state.size();
+    return sizeof(BallOutcome) + entries * sizeof(SelfStress::value_type);
+  }
+};
+
+/// Workspace of localStressAround: marks sized once for the whole Jacobian (a stamp per ball instead of
+/// clearing them), and the ball's own lists, reused from ball to ball, so a ball costs what it holds (a
+/// braced lattice asks for one per cell).
 struct BallWorkspace {
   std::vector<int> rowStamp, columnStamp, columnGrown, columnLocal;
   int stamp = 0;
+  std::vector<int> ball, columns, entryColumn, rowStart, kept, keptRows;
+  LonelyRowPeeler peeler;
+  SparseJacobian local;
+  std::vector<std::pair<int, double>> rowScratch;
+  core_detail::LocalMemo<BallOutcome> memo;
+  core_detail::LocalMemo<std::vector<char>> peelMemo;
 };
 
-/// The rows of a ball that can carry a state: a row alone on one of its coordinates (within the ball) has
-/// multiplier 0 in every state of the ball, so it goes, and so on inwards. Row i's triplets are
-/// [rowStart[i], rowStart[i + 1]) (one entry past the last row). Returns 1 for each row that stays.
-std::vector<char> peelLonelyRows(const std::vector<Eigen::Triplet<double>>& triplets,
-                                 const std::vector<int>& rowStart, int numRows, size_t numColumns) {
-  std::vector<int> count(numColumns + 1, 0);  // then the start of each column's rows
-  for (const Eigen::Triplet<double>& t : triplets)
-    ++count[static_cast<size_t>(t.col())];
-  std::vector<int> columnStart(numColumns + 1, 0), columnRows(triplets.size());
-  for (size_t c = 0; c < numColumns; ++c)
-    columnStart[c + 1] = columnStart[c] + count[c];
-  {
-    std::vector<int> fill(columnStart.begin(), columnStart.end() - 1);
-    for (const Eigen::Triplet<double>& t : triplets)
-      columnRows[static_cast<size_t>(fill[static_cast<size_t>(t.col())]++)] = t.row();
+/**
+ * Kept row k's dependency (it depends on the rows before it) as a state: multipliers y (y^T J = 0 for J as
+ * written), signed so that its cables are in tension, by kept row; nothing when it has no cable or pulls some
+ * cables and pushes others. A state through the seed (kept row 0) has y_seed = 1 and becomes
+ * outcome.throughSeed (returns true); one elsewhere in the ball is scaled to unit largest and added to
+ * outcome.elsewhere.
+ */
+bool readState(SparseElimination& elimination, int k, const std::vector<int>& keptRows,
+               const Eigen::VectorXd& rowNorm, const std::vector<char>& isCable, BallOutcome& outcome) {
+  const std::optional<SelfStress> dependency =
+      elimination.traceDependency(k, elimination.multipliers(), kMaxBallEquations);
+  if (!dependency)
+    return false;
+  double seedValue = 0.0, largest = 0.0;
+  for (const auto& [i, z] : *dependency) {
+    largest = std::max(largest, std::abs(z));
+    if (i == 0)
+      seedValue = z;
   }
-  std::vector<char> alive(static_cast<size_t>(numRows), 1);
-  std::vector<int> lonely;
-  for (size_t c = 0; c < numColumns; ++c) {
-    if (count[c] == 1)
-      lonely.push_back(columnRows[static_cast<size_t>(columnStart[c])]);
-  }
-  while (!lonely.empty()) {
-    const int i = lonely.back();
-    lonely.pop_back();
-    if (!alive[static_cast<size_t>(i)])
+  SelfStress stress;
+  stress.reserve(dependency->size());
+  int pulled = 0, pushed = 0;
+  for (const auto& [i, z] : *dependency) {
+    if (std::abs(z) <= kLocalNoise * largest)
       continue;
-    alive[static_cast<size_t>(i)] = 0;
-    for (int e = rowStart[static_cast<size_t>(i)]; e < rowStart[static_cast<size_t>(i) + 1]; ++e) {
-      const size_t c = static_cast<size_t>(triplets[static_cast<size_t>(e)].col());
-      if (--count[c] != 1)
-        continue;
-      for (int k = columnStart[c]; k < columnStart[c + 1]; ++k) {
-        if (alive[static_cast<size_t>(columnRows[static_cast<size_t>(k)])])
-          lonely.push_back(columnRows[static_cast<size_t>(k)]);
-      }
-    }
+    const int row = keptRows[static_cast<size_t>(i)];
+    const double y = z / rowNorm(row);  // z refers to the scaled rows
+    if (isCable[static_cast<size_t>(row)])
+      (y > 0.0 ? pulled : pushed) += 1;
+    stress.emplace_back(i, y);
   }
+  if ((pulled > 0) == (pushed > 0))
+    return false;
+  const bool throughSeed = std::abs(seedValue) > kSeedShare * largest;
+  double unit = pulled > 0 ? 1.0 : -1.0;
+  if (throughSeed)
+    unit = seedValue / rowNorm(keptRows[0]);
+  else
+    unit /= largest;
+  for (auto& entry : stress)
+    entry.second /= unit;
+  if (!throughSeed) {
+    outcome.elsewhere.push_back(std::move(stress));  // it tensions its own cables
+    return false;
+  }
+  outcome.throughSeed = std::move(stress);
+  return true;
+}
+
+/// Eliminates the kept rows of a ball afresh, in their order (@p local: row k is J's row keptRows[k]), and
+/// reads each dependent row's state (readState) until one passes through the seed.
+BallOutcome eliminateBall(const SparseJacobian& local, const std::vector<int>& keptRows,
+                          const Eigen::VectorXd& rowNorm, const std::vector<char>& isCable) {
+  BallOutcome outcome;
+  SparseElimination elimination(static_cast<int>(local.cols()), {}, kLocalRank, true);
+  for (int k = 0; k < static_cast<int>(local.rows()); ++k) {
+    if (elimination.addRow(local, k, 1.0 / rowNorm(keptRows[static_cast<size_t>(k)])).dependent &&
+        readState(elimination, k, keptRows, rowNorm, isCable, outcome))
+      break;
+  }
+  return outcome;
+}
+
+/// The ball's rows that can carry a state (LonelyRowPeeler), known from an equal pattern where there was one.
+const std::vector<char>& peel(BallWorkspace& work, int numRows, size_t numColumns) {
+  core_detail::LocalMemo<std::vector<char>>& memo = work.peelMemo;
+  if (!memo.active())
+    return work.peeler.peel(work.entryColumn, work.rowStart, numRows, numColumns);
+  memo.clearKey();
+  memo.appendKey(static_cast<uint64_t>(numRows));
+  memo.appendKey(static_cast<uint64_t>(numColumns));
+  memo.appendKey(work.rowStart.data(), work.rowStart.size());
+  memo.appendKey(work.entryColumn.data(), work.entryColumn.size());
+  if (const std::vector<char>* known = memo.find())
+    return *known;
+  const std::vector<char>& alive = work.peeler.peel(work.entryColumn, work.rowStart, numRows, numColumns);
+  memo.insert(alive, alive.size());
   return alive;
 }
 
@@ -169,12 +286,17 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
                                             int seed, BallWorkspace& work,
                                             const std::function<void(const SelfStress&)>& found) {
   const int stamp = work.stamp++;
-  std::vector<int> ball{seed}, columns;
+  std::vector<int>& ball = work.ball;
+  std::vector<int>& columns = work.columns;
+  std::vector<int>& entryColumn = work.entryColumn;  // local column of each entry of ball[0, entryRows)
+  std::vector<int>& rowStart = work.rowStart;        // row i's entries: [rowStart[i], rowStart[i + 1])
+  ball.assign(1, seed);
+  columns.clear();
+  entryColumn.clear();
+  rowStart.clear();
   work.rowStamp[seed] = stamp;
   size_t layerStart = 0;
-  std::vector<Eigen::Triplet<double>> triplets;  // of ball[0, tripletRows)
-  int tripletRows = 0;
-  std::vector<int> rowStart;  // row i's triplets: [rowStart[i], rowStart[i + 1])
+  int entryRows = 0;
   for (int layer = 0; layer < kMaxBallLayers; ++layer) {
     // Grow: every row on a coordinate of the last layer's rows.
     const size_t layerEnd = ball.size();
@@ -198,8 +320,8 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
       return std::nullopt;
     // The ball's rows over its columns, numbered locally in order of appearance.
     const int numRows = static_cast<int>(ball.size());
-    for (int i = tripletRows; i < numRows; ++i) {
-      rowStart.push_back(static_cast<int>(triplets.size()));
+    for (int i = entryRows; i < numRows; ++i) {
+      rowStart.push_back(static_cast<int>(entryColumn.size()));
       for (SparseJacobian::InnerIterator it(J, ball[static_cast<size_t>(i)]); it; ++it) {
         const int column = static_cast<int>(it.col());
         if (work.columnStamp[column] != stamp) {
@@ -207,20 +329,22 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
           work.columnLocal[column] = static_cast<int>(columns.size());
           columns.push_back(column);
         }
-        triplets.emplace_back(i, work.columnLocal[column], it.value());
+        entryColumn.push_back(work.columnLocal[column]);
       }
     }
-    tripletRows = numRows;
-    rowStart.push_back(static_cast<int>(triplets.size()));  // end of the last row, popped below
+    entryRows = numRows;
+    rowStart.push_back(static_cast<int>(entryColumn.size()));  // end of the last row, popped below
     if (static_cast<int>(columns.size()) > kMaxBallColumns)
       return std::nullopt;
-    // Peel the rows that cannot carry a state; what stays is where the ball's states can be.
-    const std::vector<char> alive = peelLonelyRows(triplets, rowStart, numRows, columns.size());
+    // Peel the rows that cannot carry a state; what stays is where the ball's states can be. The peeling
+    // reads the ball's pattern only, so the same pattern elsewhere peels the same (LocalMemo).
+    const std::vector<char>& alive = peel(work, numRows, columns.size());
     rowStart.pop_back();
     if (!alive[0])
       continue;  // no state through the seed yet
     // What stays, in the order seed, other rows, other cables (each by layer).
-    std::vector<int> kept{0}, position(static_cast<size_t>(numRows), -1);
+    std::vector<int>& kept = work.kept;
+    kept.assign(1, 0);
     for (int pass = 0; pass < 2; ++pass) {
       for (int i = 1; i < numRows; ++i) {
         if (alive[static_cast<size_t>(i)] &&
@@ -228,67 +352,48 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
           kept.push_back(i);
       }
     }
+    work.keptRows.resize(kept.size());
     for (size_t k = 0; k < kept.size(); ++k)
-      position[static_cast<size_t>(kept[k])] = static_cast<int>(k);
-    std::vector<Eigen::Triplet<double>> keptTriplets;
-    for (const Eigen::Triplet<double>& t : triplets) {
-      if (alive[static_cast<size_t>(t.row())])
-        keptTriplets.emplace_back(position[static_cast<size_t>(t.row())], t.col(), t.value());
+      work.keptRows[k] = ball[static_cast<size_t>(kept[k])];
+    SparseJacobian& local = work.local;
+    core_detail::copyRows(
+        J, work.keptRows, [&](int column) { return work.columnLocal[column]; },
+        static_cast<int>(columns.size()), local, work.rowScratch);
+    // The same ball elsewhere (a regular structure) gives the same outcome to the bit (LocalMemo): its
+    // elimination reads the local matrix and each kept row's norm and kind, nothing else.
+    core_detail::LocalMemo<BallOutcome>& memo = work.memo;
+    const BallOutcome* outcome = nullptr;
+    const bool keyed = memo.active();
+    if (keyed) {
+      memo.clearKey();
+      memo.appendKey(local);
+      for (int row : work.keptRows) {
+        memo.appendKey(rowNorm(row));
+        memo.appendKey(static_cast<uint64_t>(isCable[static_cast<size_t>(row)]));
+      }
+      outcome = memo.find();
     }
-    const int numKept = static_cast<int>(kept.size());
-    SparseJacobian local(numKept, static_cast<Eigen::Index>(columns.size()));
-    local.setFromTriplets(keptTriplets.begin(), keptTriplets.end());
-    // A dependency of row i as multipliers (y^T J = 0 for J as written), signed so that its cables are in
-    // tension; nothing when it has no cable or pulls some cables and pushes others. A state through the
-    // seed has y_seed = 1.
-    auto stateOf = [&](SparseElimination& elimination, int i) -> std::optional<SelfStress> {
-      const std::optional<SelfStress> dependency =
-          elimination.traceDependency(i, elimination.multipliers(), kMaxBallEquations);
-      if (!dependency)
-        return std::nullopt;
-      double seedValue = 0.0, largest = 0.0;
-      for (const auto& [k, z] : *dependency) {
-        largest = std::max(largest, std::abs(z));
-        if (k == 0)
-          seedValue = z;
-      }
-      SelfStress stress;
-      stress.reserve(dependency->size());
-      int pulled = 0, pushed = 0;
-      for (const auto& [k, z] : *dependency) {
-        if (std::abs(z) <= kLocalNoise * largest)
-          continue;
-        const int row = ball[static_cast<size_t>(kept[static_cast<size_t>(k)])];
-        const double y = z / rowNorm(row);  // z refers to the scaled rows
-        if (isCable[static_cast<size_t>(row)])
-          (y > 0.0 ? pulled : pushed) += 1;
-        stress.emplace_back(row, y);
-      }
-      if ((pulled > 0) == (pushed > 0))
-        return std::nullopt;
-      const bool throughSeed = std::abs(seedValue) > kSeedShare * largest;
-      double unit = pulled > 0 ? 1.0 : -1.0;
-      if (throughSeed)
-        unit = seedValue / rowNorm(seed);
-      else
-        unit /= largest;
-      for (auto& entry : stress)
-        entry.second /= unit;
-      if (!throughSeed) {
-        found(stress);  // a state elsewhere in the ball: it tensions its own cables
-        return std::nullopt;
-      }
-      return stress;
+    BallOutcome fresh;
+    if (!outcome) {
+      fresh = eliminateBall(local, work.keptRows, rowNorm, isCable);
+      outcome = &fresh;
+    }
+    auto inRows = [&](SelfStress state) {
+      for (auto& entry : state)
+        entry.first = work.keptRows[static_cast<size_t>(entry.first)];
+      return state;
     };
-    SparseElimination elimination(static_cast<int>(columns.size()), {}, kLocalRank, true);
-    for (int k = 0; k < numKept; ++k) {
-      if (!elimination
-               .addRow(local, k, 1.0 / rowNorm(ball[static_cast<size_t>(kept[static_cast<size_t>(k)])]))
-               .dependent)
-        continue;
-      if (std::optional<SelfStress> stress = stateOf(elimination, k))
-        return stress;
+    for (const SelfStress& state : outcome->elsewhere)
+      found(inRows(state));
+    std::optional<SelfStress> result;
+    if (outcome->throughSeed)
+      result = inRows(*outcome->throughSeed);
+    if (keyed && outcome == &fresh) {
+      const size_t bytes = fresh.bytes();
+      memo.insert(std::move(fresh), bytes);
     }
+    if (result)
+      return result;
   }
   return std::nullopt;
 }

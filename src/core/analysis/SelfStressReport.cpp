@@ -63,32 +63,26 @@ std::vector<ElementForce> elementForces(const Mechanism& mechanism, const Coordi
   }
   const std::vector<Share> signedForce = sumByKey(signedShares);
   const std::vector<Share> squares = sumByKey(squareShares);
-  std::vector<ElementForce> forces;
-  forces.reserve(signedForce.size() + squares.size());
-  auto name = [&](const std::pair<int, int>& key, std::string& kind) -> const std::string& {
-    const auto source = static_cast<EquationSource>(key.first);
-    if (source == EquationSource::Joint) {
-      kind = toString(mechanism.joints[key.second].kind);
-      return mechanism.joints[key.second].name;
-    }
-    kind = source == EquationSource::Link ? "link" : "boundary";
-    return mechanism.links[key.second].name;
+  // Forces as (key, signed?, value), signed first, then the magnitudes; named only once kept and sorted, so
+  // the sort moves no strings (a large grid's report asks this of tens of thousands of states).
+  struct Force {
+    std::pair<int, int> key;
+    bool isSigned;  // a cable's or distance constraint's, whichever its equation
+    double value;
   };
-  for (const Share& share : signedForce) {
-    ElementForce f;
-    f.name = name(share.key, f.kind);
-    f.force = share.value;
-    forces.push_back(f);
-  }
-  for (const Share& share : squares) {
-    ElementForce f;
-    f.name = name(share.key, f.kind);
-    f.force = std::sqrt(share.value);
-    forces.push_back(f);
-  }
+  auto distanceLike = [&](const std::pair<int, int>& key) {
+    return static_cast<EquationSource>(key.first) == EquationSource::Joint &&
+           isDistanceLike(mechanism.joints[key.second]);
+  };
+  std::vector<Force> forces;
+  forces.reserve(signedForce.size() + squares.size());
+  for (const Share& share : signedForce)
+    forces.push_back(Force{share.key, distanceLike(share.key), share.value});
+  for (const Share& share : squares)
+    forces.push_back(Force{share.key, distanceLike(share.key), std::sqrt(share.value)});
   double largest = 0.0;
-  for (const ElementForce& f : forces)
-    largest = std::max(largest, std::abs(f.force));
+  for (const Force& f : forces)
+    largest = std::max(largest, std::abs(f.value));
   // Sign of a state is free: make its largest signed (cable / distance) force a tension.
   double largestSigned = 0.0;
   for (const Share& share : signedForce) {
@@ -99,15 +93,32 @@ std::vector<ElementForce> elementForces(const Mechanism& mechanism, const Coordi
   std::vector<ElementForce> kept;
   if (largest <= 0.0)
     return kept;
-  for (ElementForce& f : forces) {
-    const bool isSigned = f.kind == "cable" || f.kind == "distance_constraint";
-    f.force = (isSigned ? sign : 1.0) * f.force / largest;
-    if (std::abs(f.force) > kSupportFloor)
-      kept.push_back(std::move(f));
+  std::vector<int> order;
+  order.reserve(forces.size());
+  for (size_t i = 0; i < forces.size(); ++i) {
+    Force& f = forces[i];
+    f.value = (f.isSigned ? sign : 1.0) * f.value / largest;
+    if (std::abs(f.value) > kSupportFloor)
+      order.push_back(static_cast<int>(i));
   }
-  std::stable_sort(kept.begin(), kept.end(), [](const ElementForce& a, const ElementForce& b) {
-    return std::abs(a.force) > std::abs(b.force);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return std::abs(forces[static_cast<size_t>(a)].value) > std::abs(forces[static_cast<size_t>(b)].value);
   });
+  kept.reserve(order.size());
+  for (int i : order) {
+    const Force& f = forces[static_cast<size_t>(i)];
+    ElementForce force;
+    const auto source = static_cast<EquationSource>(f.key.first);
+    if (source == EquationSource::Joint) {
+      force.kind = toString(mechanism.joints[f.key.second].kind);
+      force.name = mechanism.joints[f.key.second].name;
+    } else {
+      force.kind = source == EquationSource::Link ? "link" : "boundary";
+      force.name = mechanism.links[f.key.second].name;
+    }
+    force.force = f.value;
+    kept.push_back(std::move(force));
+  }
   return kept;
 }
 
