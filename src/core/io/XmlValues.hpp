@@ -2,11 +2,15 @@
 
 // Private to the readers in src/core/io: strict number parsing shared by the XML readers.
 
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <optional>
-#include <sstream>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -16,21 +20,45 @@
 namespace mobility_analysis {
 namespace io_detail {
 
-/// @return The number in @p text (surrounding blanks allowed), or nothing when it is not one.
-inline std::optional<double> parseDouble(const std::string& text) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  const double value = std::strtod(begin, &end);
-  if (end == begin) {
+/// Blanks as std::strtod skips them before a number (the "C" locale's isspace).
+inline bool isSpace(char c) {
+  return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r';
+}
+
+/**
+ * @brief The number that is exactly the characters [@p begin, @p end) as std::strtod reads them, or nothing
+ *        when strtod would stop before @p end.
+ *
+ * std::from_chars first (no locale, no errno; about 4x faster than strtod): wherever it reads the whole
+ * range, strtod reads the same range to the same double (both round correctly). Everything else — a leading
+ * '+' or blank, hexadecimal, out of range, not a number — goes to strtod itself, so the values and the
+ * refusals are strtod's, as before.
+ * @note *end must be a character strtod stops at (a blank or '\0'): strtod reads on to it.
+ */
+inline std::optional<double> parseNumber(const char* begin, const char* end) {
+  double value = 0.0;
+  const std::from_chars_result fast = std::from_chars(begin, end, value);
+  if (fast.ec == std::errc() && fast.ptr == end)
+    return value;
+  char* stop = nullptr;
+  value = std::strtod(begin, &stop);
+  if (stop == begin || stop != end)
     return std::nullopt;
-  }
-  while (*end == ' ' || *end == '\t' || *end == '\n' || *end == '\r') {
-    ++end;
-  }
-  if (*end != '\0') {
-    return std::nullopt;
-  }
   return value;
+}
+
+/// @return The number in @p text (surrounding blanks allowed), or nothing when it is not one.
+inline std::optional<double> parseDouble(const char* text) {
+  const char* begin = text;
+  while (isSpace(*begin))
+    ++begin;
+  const char* end = begin + std::strlen(begin);
+  while (end > begin && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\n' || end[-1] == '\r'))
+    --end;
+  if (end == begin)
+    return std::nullopt;
+  // strtod stops at a blank, so the number is [begin, end) or the text is not one.
+  return parseNumber(begin, end);
 }
 
 /// Why a number was refused, or nothing when it is usable: finite and |x| <= tolerances::kMaxCoordinate.
@@ -76,29 +104,35 @@ inline Eigen::Isometry3d makeOriginFrame(const Eigen::Vector3d& xyz, const Eigen
   return frame;
 }
 
-/// Reads the whole file at @p path into @p text in one read (no stream copies); false when it cannot be read.
+/**
+ * @brief Reads the whole file at @p path into @p text; false when it cannot be read (also a directory).
+ *
+ * A regular file is read in one fread straight into the string, sized from fstat (one allocation, no block
+ * copies: a 10^6-link chain is 0.3 GB); anything else (a pipe) in 64 KiB blocks.
+ */
 inline bool readWholeFile(const std::string& path, std::string& text) {
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr)
     return false;
+  struct stat status {};
+  size_t size = 0;  // expected; one more byte is asked for so that the first read meets the end
+  if (::fstat(::fileno(file), &status) == 0 && S_ISREG(status.st_mode) && status.st_size > 0)
+    size = static_cast<size_t>(status.st_size);
   text.clear();
-  char buffer[1 << 16];
-  if (std::fseek(file, 0, SEEK_END) == 0) {
-    const long size = std::ftell(file);
-    if (size > 0)
-      text.reserve(static_cast<size_t>(size));
-    std::rewind(file);
-  }
+  size_t used = 0;
   bool ok = true;
   while (true) {
-    const size_t got = std::fread(buffer, 1, sizeof(buffer), file);
-    text.append(buffer, got);
-    if (got < sizeof(buffer)) {
+    if (used == text.size())
+      text.resize(std::max({2 * used, size + 1, size_t{1} << 16}));
+    const size_t got = std::fread(&text[used], 1, text.size() - used, file);
+    used += got;
+    if (used < text.size()) {  // a short read: the end, or an error
       ok = std::ferror(file) == 0;
       break;
     }
   }
   std::fclose(file);
+  text.resize(used);
   return ok;
 }
 
