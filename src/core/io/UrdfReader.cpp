@@ -99,11 +99,11 @@ enum TopLevel : int { kLink, kJoint, kDistance, kCable, kLoopJoint, kLoop, kCoup
 
 TopLevel classify(const char* tag) {
   for (size_t i = 0; i < kReadElements.size(); ++i) {
-    if (std::strcmp(tag, kReadElements[i]) == 0)
+    if (tag[0] == kReadElements[i][0] && std::strcmp(tag, kReadElements[i]) == 0)
       return static_cast<TopLevel>(i);
   }
   for (const char* ignored : kIgnoredElements) {
-    if (std::strcmp(tag, ignored) == 0)
+    if (tag[0] == ignored[0] && std::strcmp(tag, ignored) == 0)
       return kIgnored;
   }
   return kUnknown;
@@ -655,8 +655,8 @@ struct XmlFault {
 /// the shared library).
 pugi::xml_attribute repeatedAttribute(Element e) {
   pugi::xml_attribute a = e.first_attribute();
-  if (!a)
-    return a;
+  if (!a || !a.next_attribute())
+    return pugi::xml_attribute();
   constexpr int kGathered = 8;
   const char* names[kGathered];
   int count = 0;
