@@ -398,6 +398,8 @@ TEST(XmlValues, everyNumberIsTheDoubleStrtodReads) {
       EXPECT_EQ(std::memcmp(&*got, &expected, sizeof(double)), 0)
           << text << ": " << *got << " vs " << expected;
   }
+  for (const char* digit : {"0", "1", "7", "9"})
+    EXPECT_EQ(io_detail::parseNumber(digit, digit + 1), std::strtod(digit, nullptr));
   EXPECT_FALSE(io_detail::parseNumber("1e", std::strchr("1e", '\0')));
   EXPECT_FALSE(io_detail::parseDouble(" 1 2"));
   EXPECT_EQ(io_detail::parseDouble("\v 2.5\r\n"), 2.5);
@@ -439,4 +441,18 @@ TEST(UrdfLoader, whatIsNotWellFormedXmlIsRefusedAndTextIsReadAsWritten) {
   EXPECT_EQ(valueOf(read).name, "a&bA");
   EXPECT_EQ(valueOf(read).links[0].name, "t\tab");
   EXPECT_EQ(valueOf(read).links[1].name, "l\nf");
+}
+
+TEST(XmlValues, aZeroRollPitchYawGivesTheQuaternionFormulasIdentityBitForBit) {
+  const Eigen::Vector3d xyz(0.1, -2, 3e-5);
+  const auto sameBits = [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+    return std::memcmp(a.matrix().data(), b.matrix().data(), 16 * sizeof(double)) == 0;
+  };
+  for (const Eigen::Vector3d& rpy : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(-0.0, 0, 0),
+                                     Eigen::Vector3d(0, 0, -0.0), Eigen::Vector3d(0.3, -1.2, 2.5)}) {
+    Eigen::Isometry3d expected = Eigen::Isometry3d::Identity();
+    expected.linear() = io_detail::originRotation(rpy);  // the general formula, always
+    expected.translation() = xyz;
+    EXPECT_TRUE(sameBits(io_detail::makeOriginFrame(xyz, rpy), expected)) << rpy.transpose();
+  }
 }

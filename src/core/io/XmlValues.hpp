@@ -36,6 +36,8 @@ inline bool isSpace(char c) {
  * @note *end must be a character strtod stops at (a blank or '\0'): strtod reads on to it.
  */
 inline std::optional<double> parseNumber(const char* begin, const char* end) {
+  if (end - begin == 1 && *begin >= '0' && *begin <= '9')  // "0", "1": most of a URDF's numbers
+    return static_cast<double>(*begin - '0');
   double value = 0.0;
   const std::from_chars_result fast = std::from_chars(begin, end, value);
   if (fast.ec == std::errc() && fast.ptr == end)
@@ -83,11 +85,9 @@ inline Eigen::Isometry3d makeFrame(const Eigen::Vector3d& xyz, const Eigen::Vect
   return frame;
 }
 
-/**
- * @brief A URDF `<joint><origin>` frame, its rotation through the quaternion of roll-pitch-yaw as urdfdom
- *        computes it (then normalised), so tree-joint frames are bit for bit those urdfdom gave.
- */
-inline Eigen::Isometry3d makeOriginFrame(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy) {
+/// The rotation of URDF roll-pitch-yaw @p rpy through its quaternion, as urdfdom computes it (then
+/// normalised).
+inline Eigen::Matrix3d originRotation(const Eigen::Vector3d& rpy) {
   const double phi = rpy.x() / 2.0, the = rpy.y() / 2.0, psi = rpy.z() / 2.0;
   double x = std::sin(phi) * std::cos(the) * std::cos(psi) - std::cos(phi) * std::sin(the) * std::sin(psi);
   double y = std::cos(phi) * std::sin(the) * std::cos(psi) + std::sin(phi) * std::cos(the) * std::sin(psi);
@@ -98,9 +98,21 @@ inline Eigen::Isometry3d makeOriginFrame(const Eigen::Vector3d& xyz, const Eigen
   y /= norm;
   z /= norm;
   w /= norm;
+  return Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
+}
+
+/**
+ * @brief A URDF `<joint><origin>` frame, its rotation through the quaternion of roll-pitch-yaw as urdfdom
+ *        computes it (then normalised), so tree-joint frames are bit for bit those urdfdom gave.
+ */
+inline Eigen::Isometry3d makeOriginFrame(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy) {
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
-  frame.linear() = Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
   frame.translation() = xyz;
+  if (!(rpy.x() == 0.0 && rpy.y() == 0.0 && rpy.z() == 0.0 && !std::signbit(rpy.x()) &&
+        !std::signbit(rpy.y()) && !std::signbit(rpy.z())))
+    frame.linear() = originRotation(rpy);
+  // else rpy is +0 +0 +0 (most tree joints): sin +0 = +0 and cos +0 = 1 exactly, so the quaternion is
+  // (1, +0, +0, +0) and its matrix the identity, bit for bit (UrdfLoaderTest checks it).
   return frame;
 }
 
