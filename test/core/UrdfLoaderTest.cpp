@@ -443,7 +443,7 @@ TEST(UrdfLoader, whatIsNotWellFormedXmlIsRefusedAndTextIsReadAsWritten) {
   EXPECT_EQ(valueOf(read).links[1].name, "l\nf");
 }
 
-TEST(XmlValues, aZeroRollPitchYawGivesTheQuaternionFormulasIdentityBitForBit) {
+TEST(XmlValues, aZeroRollPitchYawGivesTheGeneralFormulasIdentityBitForBit) {
   const Eigen::Vector3d xyz(0.1, -2, 3e-5);
   const auto sameBits = [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
     return std::memcmp(a.matrix().data(), b.matrix().data(), 16 * sizeof(double)) == 0;
@@ -454,5 +454,7 @@ TEST(XmlValues, aZeroRollPitchYawGivesTheQuaternionFormulasIdentityBitForBit) {
     expected.linear() = io_detail::originRotation(rpy);  // the general formula, always
     expected.translation() = xyz;
     EXPECT_TRUE(sameBits(io_detail::makeOriginFrame(xyz, rpy), expected)) << rpy.transpose();
+    expected.linear() = io_detail::rollPitchYaw(rpy);  // and the loop elements' angle-axis product
+    EXPECT_TRUE(sameBits(io_detail::makeFrame(xyz, rpy), expected)) << rpy.transpose();
   }
 }

@@ -544,15 +544,16 @@ class Reader {
       checkChildren(e, kind, joint.name, {"link1", "link2", "axis", "axis2", "limit", "dynamics"});
       readEnds(e, "link1", "link2", kind, joint);
     }
-    if (needsAxis(joint.type) && !e.child("axis")) {
+    const auto [axisElement, axis2Element] = childrenNamed<2>(e, {"axis", "axis2"});
+    if (needsAxis(joint.type) && !axisElement) {
       warn(kind, joint.name,
            std::string("type ") + toString(joint.type) + " has no <axis>; axis defaulted to 1 0 0");
     }
-    if (joint.type == JointType::Universal && !e.child("axis2")) {
+    if (joint.type == JointType::Universal && !axis2Element) {
       warn(kind, joint.name, "type universal has no <axis2>; axis2 defaulted to 0 1 0");
     }
-    joint.axis = axis(e.child("axis"), "axis", kind, joint.name, Eigen::Vector3d::UnitX());
-    joint.axis2 = axis(e.child("axis2"), "axis2", kind, joint.name, Eigen::Vector3d::UnitY());
+    joint.axis = axis(axisElement, "axis", kind, joint.name, Eigen::Vector3d::UnitX());
+    joint.axis2 = axis(axis2Element, "axis2", kind, joint.name, Eigen::Vector3d::UnitY());
     if (joint.type == JointType::Universal && joint.axis.cross(joint.axis2).norm() < tolerances::kPlanarAxis)
       fail(kind, joint.name, "universal joint axes 'axis' and 'axis2' are parallel");
     addConnection(std::move(joint));

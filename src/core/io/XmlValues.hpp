@@ -74,13 +74,27 @@ inline std::optional<std::string> checkRange(double value) {
   return std::nullopt;
 }
 
+/// True when @p rpy is +0 +0 +0 (not -0): the angles whose rotation is the identity bit for bit.
+inline bool isPositiveZero(const Eigen::Vector3d& rpy) {
+  return rpy.x() == 0.0 && rpy.y() == 0.0 && rpy.z() == 0.0 && !std::signbit(rpy.x()) &&
+         !std::signbit(rpy.y()) && !std::signbit(rpy.z());
+}
+
 /// URDF fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll).
+inline Eigen::Matrix3d rollPitchYaw(const Eigen::Vector3d& rpy) {
+  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+/// The frame at @p xyz turned by roll-pitch-yaw @p rpy; +0 +0 +0 (most frames) skips the product of the
+/// three angle-axis quaternions, each (1, +0, +0, +0), whose matrix is the identity bit for bit
+/// (UrdfLoaderTest checks it).
 inline Eigen::Isometry3d makeFrame(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy) {
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
-  frame.linear() = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-                    Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-                    Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-                       .toRotationMatrix();
+  if (!isPositiveZero(rpy))
+    frame.linear() = rollPitchYaw(rpy);
   frame.translation() = xyz;
   return frame;
 }
@@ -108,8 +122,7 @@ inline Eigen::Matrix3d originRotation(const Eigen::Vector3d& rpy) {
 inline Eigen::Isometry3d makeOriginFrame(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy) {
   Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
   frame.translation() = xyz;
-  if (!(rpy.x() == 0.0 && rpy.y() == 0.0 && rpy.z() == 0.0 && !std::signbit(rpy.x()) &&
-        !std::signbit(rpy.y()) && !std::signbit(rpy.z())))
+  if (!isPositiveZero(rpy))
     frame.linear() = originRotation(rpy);
   // else rpy is +0 +0 +0 (most tree joints): sin +0 = +0 and cos +0 = 1 exactly, so the quaternion is
   // (1, +0, +0, +0) and its matrix the identity, bit for bit (UrdfLoaderTest checks it).
