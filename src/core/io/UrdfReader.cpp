@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <initializer_list>
+#include <optional>
 #include <string_view>
 
 #include <pugixml.hpp>
@@ -678,7 +679,7 @@ pugi::xml_attribute repeatedAttribute(Element e) {
     }
     ++count;
   }
-  return a;
+  return pugi::xml_attribute();
 }
 
 /**
