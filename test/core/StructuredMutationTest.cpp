@@ -394,6 +394,9 @@ TEST(StructuredMutations, everyMutantGivesAValidReportOrOneDiagnosticLine) {
     const std::string name =
         "mutant" + std::to_string(m) + std::filesystem::path(seeds[s]).extension().string();
     SCOPED_TRACE(name + " of " + seeds[s] + ": " + log);
+    // MA_MUTANT_DIR keeps every mutant, to compare two builds' answers on them (a reader port, say).
+    if (const char* keep = std::getenv("MA_MUTANT_DIR"))
+      std::ofstream(std::string(keep) + "/" + name, std::ios::binary) << mutant;
 
     const auto start = std::chrono::steady_clock::now();
     bool ok = false;

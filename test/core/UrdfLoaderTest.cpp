@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <numeric>
 #include <random>
@@ -9,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "../../src/core/io/NameIndex.hpp"
+#include "../../src/core/io/XmlValues.hpp"
 #include "core/TestModels.hpp"
 #include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/io/SdfReader.hpp"
@@ -364,5 +367,94 @@ TEST(ReadMechanism, aDirectoryOrAMissingFileCannotBeOpened) {
       EXPECT_NE(diagnosticOf(read).what.find("cannot open the file"), std::string::npos)
           << diagnosticOf(read).toString();
     }
+  }
+}
+
+TEST(XmlValues, everyNumberIsTheDoubleStrtodReads) {
+  // The fast path (std::from_chars) must give strtod's double bit for bit wherever it answers: random doubles
+  // of every magnitude (subnormals too) in the forms files use, and strtod's own forms behind it.
+  std::mt19937_64 random(13);
+  std::vector<std::string> texts = {"0",     "-0",      "1e-320", "4.9e-324", "2.2250738585072014e-308",
+                                    "1e308", ".5",      "5.",     "+1",       "0x1p3",
+                                    "1e400", "-1e-400", "nan",    "inf",      "-Infinity"};
+  for (int i = 0; i < 20000; ++i) {
+    double value = 0.0;
+    const uint64_t bits = random();
+    std::memcpy(&value, &bits, sizeof(value));
+    if (!std::isfinite(value))
+      continue;
+    char text[64];
+    std::snprintf(text, sizeof(text), i % 3 == 0 ? "%.17g" : i % 3 == 1 ? "%.6e" : "%.3f", value);
+    texts.push_back(text);
+    std::snprintf(text, sizeof(text), "%.15g", static_cast<double>(random() % 100000) / 1000.0);
+    texts.push_back(text);
+  }
+  for (const std::string& text : texts) {
+    char* end = nullptr;
+    const double expected = std::strtod(text.c_str(), &end);
+    const std::optional<double> got = io_detail::parseNumber(text.data(), text.data() + text.size());
+    ASSERT_EQ(got.has_value(), *end == '\0') << text;
+    if (got && !std::isnan(expected))
+      EXPECT_EQ(std::memcmp(&*got, &expected, sizeof(double)), 0)
+          << text << ": " << *got << " vs " << expected;
+  }
+  for (const char* digit : {"0", "1", "7", "9"})
+    EXPECT_EQ(io_detail::parseNumber(digit, digit + 1), std::strtod(digit, nullptr));
+  EXPECT_FALSE(io_detail::parseNumber("1e", std::strchr("1e", '\0')));
+  EXPECT_FALSE(io_detail::parseDouble(" 1 2"));
+  EXPECT_EQ(io_detail::parseDouble("\v 2.5\r\n"), 2.5);
+}
+
+TEST(UrdfLoader, whatIsNotWellFormedXmlIsRefusedAndTextIsReadAsWritten) {
+  const std::string tree =
+      R"(<link name="a"/><link name="b"/><joint name="j" type="revolute"><parent link="a"/>)"
+      R"(<child link="b"/><axis xyz="0 0 1"/></joint>)";
+  // XML 1.0 §2.1, §3.1: one root, no text outside it, each attribute once, a blank between attributes.
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"<robot name=\"r\">" + tree + "</robot>trailing", "text outside the root element at line 1"},
+      {"before<robot name=\"r\">" + tree + "</robot>", "text outside the root element"},
+      {"<robot name=\"r\" name=\"s\">" + tree + "</robot>", "attribute 'name' given twice in <robot>"},
+      {"<robot name=\"r\">\n" + tree +
+           "\n<link name=\"c\"><visual><box size=\"1\" size=\"2\"/></visual></link></robot>",
+       "attribute 'size' given twice in <box> at line 3"},
+      {"<robot name=\"r\" x=\"1\"y=\"2\">" + tree + "</robot>", "not well-formed XML"},
+      {"<robot name=\"r\">" + tree + "</robot></robot>", "not well-formed XML"},
+      {"<robot name=\"r\">\n" + tree + "\n", "not well-formed XML"},
+      {"<!-- nothing else -->", "No document element found"},
+      {"", "No document element found"},
+  };
+  for (const auto& [text, fragment] : refused) {
+    const Result<Mechanism> read = loadMechanismFromString(text, "x.urdf");
+    ASSERT_FALSE(isOk(read)) << text;
+    EXPECT_EQ(diagnosticOf(read).elementKind, "xml") << text;
+    EXPECT_NE(diagnosticOf(read).what.find(fragment), std::string::npos) << diagnosticOf(read).toString();
+  }
+  // Entities decoded, CDATA and a processing instruction after the root allowed, blanks inside an attribute
+  // kept as written but for line ends (\r\n and \r become \n), as tinyxml2 read them.
+  const std::string text =
+      "<?xml version=\"1.0\"?>\n<!DOCTYPE robot>\n<robot name=\"a&amp;b&#65;\">"
+      "<link name=\"t\tab\"/><link name=\"l\r\nf\"/>"
+      "<joint name=\"j\" type=\"revolute\"><parent link=\"t\tab\"/><child link=\"l\nf\"/>"
+      "<axis xyz=\"0 0 1\"/><![CDATA[ignored]]></joint></robot>\n<?pi after?>\n";
+  const Result<Mechanism> read = loadMechanismFromString(text, "x.urdf");
+  ASSERT_TRUE(isOk(read)) << diagnosticOf(read).toString();
+  EXPECT_EQ(valueOf(read).name, "a&bA");
+  EXPECT_EQ(valueOf(read).links[0].name, "t\tab");
+  EXPECT_EQ(valueOf(read).links[1].name, "l\nf");
+}
+
+TEST(XmlValues, aZeroRollPitchYawGivesTheGeneralFormulasIdentityBitForBit) {
+  const Eigen::Vector3d xyz(0.1, -2, 3e-5);
+  const auto sameBits = [](const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+    return std::memcmp(a.matrix().data(), b.matrix().data(), 16 * sizeof(double)) == 0;
+  };
+  for (const Eigen::Vector3d& rpy : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(-0.0, 0, 0),
+                                     Eigen::Vector3d(0, 0, -0.0), Eigen::Vector3d(0.3, -1.2, 2.5)}) {
+    Eigen::Isometry3d expected = Eigen::Isometry3d::Identity();
+    expected.linear() = io_detail::originRotation(rpy);  // the general formula, always
+    expected.translation() = xyz;
+    EXPECT_TRUE(sameBits(io_detail::makeOriginFrame(xyz, rpy), expected)) << rpy.transpose();
+    expected.linear() = io_detail::rollPitchYaw(rpy);  // and the loop elements' angle-axis product
+    EXPECT_TRUE(sameBits(io_detail::makeFrame(xyz, rpy), expected)) << rpy.transpose();
   }
 }

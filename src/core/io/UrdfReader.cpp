@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <cstring>
 #include <initializer_list>
+#include <optional>
+#include <string_view>
 
-#include <tinyxml2.h>
+#include <pugixml.hpp>
 
 #include "NameIndex.hpp"
 #include "XmlValues.hpp"
@@ -20,11 +22,69 @@ namespace {
 using io_detail::checkRange;
 using io_detail::makeFrame;
 using io_detail::parseDouble;
+using io_detail::parseNumber;
+
+/// A node of the parsed document (pugixml's handle: one pointer, passed by value).
+using Element = pugi::xml_node;
+
+/// The value of attribute @p name of @p e, nullptr when @p e has none.
+const char* attributeOf(Element e, const char* name) {
+  const pugi::xml_attribute a = e.attribute(name);
+  return a ? a.value() : nullptr;
+}
+
+/// The first child of @p e that is an element (text and CDATA children are skipped), or a null node.
+Element firstChildElement(Element e) {
+  Element c = e.first_child();
+  while (c && c.type() != pugi::node_element)
+    c = c.next_sibling();
+  return c;
+}
+
+/// The next sibling of @p e that is an element, or a null node.
+Element nextSiblingElement(Element e) {
+  Element c = e.next_sibling();
+  while (c && c.type() != pugi::node_element)
+    c = c.next_sibling();
+  return c;
+}
+
+/**
+ * @brief The first child element of @p e named @p tags[i], for each i, from one scan over the children: what
+ *        e.child(tags[i]) would give, without a scan of the children (and a strcmp per child) per tag.
+ */
+template <size_t N>
+std::array<Element, N> childrenNamed(Element e, const std::array<const char*, N>& tags) {
+  std::array<Element, N> found{};
+  for (Element c = e.first_child(); c; c = c.next_sibling()) {
+    const char* name = c.name();  // "" for text
+    for (size_t i = 0; i < N; ++i) {
+      if (name[0] == tags[i][0] && std::strcmp(name, tags[i]) == 0) {
+        if (!found[i])
+          found[i] = c;
+        break;
+      }
+    }
+  }
+  return found;
+}
 
 /// A refusal inside the reader: thrown at the check that fails, caught in readUrdf and returned as its
 /// Diagnostic, so no exception leaves this file (STYLE.md §4) and the ~40 checks stay one line each.
 struct ReadFailure {
   Diagnostic diagnostic;
+};
+
+/// The label of an attribute in a diagnostic ("link1 origin xyz"), kept in up to three pieces and joined
+/// only when a diagnostic needs it: labels are built per attribute read, diagnostics are rare.
+struct Label {
+  std::string_view a, b, c;
+  Label(const char* text) : a(text) {}  // NOLINT: a literal is a label
+  Label(std::string_view first, std::string_view second, std::string_view third = {})
+      : a(first), b(second), c(third) {}
+  /// This label followed by @p suffix (at most three pieces in all).
+  Label then(std::string_view suffix) const { return b.empty() ? Label(a, suffix) : Label(a, b, suffix); }
+  std::string str() const { return std::string(a).append(b).append(c); }
 };
 
 /// Top-level elements that carry nothing for mobility and are well known: skipped without a warning.
@@ -40,11 +100,11 @@ enum TopLevel : int { kLink, kJoint, kDistance, kCable, kLoopJoint, kLoop, kCoup
 
 TopLevel classify(const char* tag) {
   for (size_t i = 0; i < kReadElements.size(); ++i) {
-    if (std::strcmp(tag, kReadElements[i]) == 0)
+    if (tag[0] == kReadElements[i][0] && std::strcmp(tag, kReadElements[i]) == 0)
       return static_cast<TopLevel>(i);
   }
   for (const char* ignored : kIgnoredElements) {
-    if (std::strcmp(tag, ignored) == 0)
+    if (tag[0] == ignored[0] && std::strcmp(tag, ignored) == 0)
       return kIgnored;
   }
   return kUnknown;
@@ -72,7 +132,7 @@ std::string squashed(const std::string& name) {
 const char* loopTypeList = "revolute, continuous, prismatic, cylindrical, spherical, universal, fixed";
 
 /// The type spelled @p type among @p allowed, by the dialect's spelling (toString(JointType)).
-std::optional<JointType> parseJointType(const std::string& type, std::initializer_list<JointType> allowed) {
+std::optional<JointType> parseJointType(std::string_view type, std::initializer_list<JointType> allowed) {
   for (const JointType candidate : allowed) {
     if (type == toString(candidate))
       return candidate;
@@ -81,14 +141,14 @@ std::optional<JointType> parseJointType(const std::string& type, std::initialize
 }
 
 /// Loop elements take every type of the dialect but the URDF tree's own planar and floating.
-std::optional<JointType> parseLoopType(const std::string& type) {
+std::optional<JointType> parseLoopType(std::string_view type) {
   return parseJointType(
       type, {JointType::Revolute, JointType::Continuous, JointType::Prismatic, JointType::Cylindrical,
              JointType::Spherical, JointType::Universal, JointType::Fixed});
 }
 
 /// Tree joints take URDF's types.
-std::optional<JointType> parseTreeType(const std::string& type) {
+std::optional<JointType> parseTreeType(std::string_view type) {
   return parseJointType(type, {JointType::Revolute, JointType::Continuous, JointType::Prismatic,
                                JointType::Fixed, JointType::Floating, JointType::Planar});
 }
@@ -117,14 +177,14 @@ class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) { mechanism_.file = file_; }
 
-  Mechanism read(const tinyxml2::XMLElement* robot) {
-    const char* robotName = robot->Attribute("name");
+  Mechanism read(Element robot) {
+    const char* robotName = attributeOf(robot, "name");
     mechanism_.name = robotName == nullptr ? "" : robotName;
     // One walk over the top-level elements sorts them by kind (document order within each kind) and warns
     // about the unknown ones; each kind is then read in the equation order of DESIGN.md §3.
-    std::array<std::vector<const tinyxml2::XMLElement*>, kIgnored> byKind;
-    for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
-      const TopLevel kind = classify(e->Name());
+    std::array<std::vector<Element>, kIgnored> byKind;
+    for (Element e = firstChildElement(robot); e; e = nextSiblingElement(e)) {
+      const TopLevel kind = classify(e.name());
       if (kind == kUnknown)
         warnUnknown(e);
       else if (kind != kIgnored)
@@ -140,23 +200,23 @@ class Reader {
     readLinks(byKind[kLink]);
     readTreeJoints(byKind[kJoint]);
     checkTree();
-    for (const tinyxml2::XMLElement* e : byKind[kDistance])
+    for (Element e : byKind[kDistance])
       readTwoEnded(e, ConnectionKind::DistanceConstraint);
-    for (const tinyxml2::XMLElement* e : byKind[kCable])
+    for (Element e : byKind[kCable])
       readTwoEnded(e, ConnectionKind::Cable);
     // <loop_joint> and <loop> in document order, mixed.
-    std::vector<const tinyxml2::XMLElement*>& loops = byKind[kLoopJoint];
+    std::vector<Element>& loops = byKind[kLoopJoint];
     if (!byKind[kLoop].empty()) {
       loops.clear();
-      for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
-        const TopLevel kind = classify(e->Name());
+      for (Element e = firstChildElement(robot); e; e = nextSiblingElement(e)) {
+        const TopLevel kind = classify(e.name());
         if (kind == kLoopJoint || kind == kLoop)
           loops.push_back(e);
       }
     }
-    for (const tinyxml2::XMLElement* e : loops)
+    for (Element e : loops)
       readLoop(e);
-    for (const tinyxml2::XMLElement* e : byKind[kCoupling])
+    for (Element e : byKind[kCoupling])
       readCoupling(e);
     for (const PendingCoupling& coupling : couplings_)
       addCoupling(coupling);
@@ -164,29 +224,28 @@ class Reader {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& kind, const std::string& name, const std::string& what) const {
-    throw ReadFailure{makeDiagnostic(file_, kind, name, what)};
+  [[noreturn]] void fail(std::string_view kind, std::string_view name, const std::string& what) const {
+    throw ReadFailure{makeDiagnostic(file_, std::string(kind), std::string(name), what)};
   }
 
   void warn(const std::string& kind, const std::string& name, const std::string& what) {
     mechanism_.warnings.push_back(makeDiagnostic(file_, kind, name, what));
   }
 
-  double number(const char* text, const std::string& kind, const std::string& name,
-                const std::string& attribute) const {
+  double number(const char* text, std::string_view kind, const std::string& name, Label attribute) const {
     if (text == nullptr)
-      fail(kind, name, "missing attribute " + attribute);
+      fail(kind, name, "missing attribute " + attribute.str());
     const std::optional<double> value = parseDouble(text);
     if (!value)
-      fail(kind, name, attribute + " '" + text + "' is not a number");
+      fail(kind, name, attribute.str() + " '" + text + "' is not a number");
     if (const std::optional<std::string> why = checkRange(*value))
-      fail(kind, name, attribute + " '" + text + "' " + *why);
+      fail(kind, name, attribute.str() + " '" + text + "' " + *why);
     return *value;
   }
 
   /// "a b c": exactly three finite numbers within range; absent: zero.
-  Eigen::Vector3d vector(const char* text, const std::string& kind, const std::string& name,
-                         const std::string& attribute) const {
+  Eigen::Vector3d vector(const char* text, std::string_view kind, const std::string& name,
+                         Label attribute) const {
     if (text == nullptr)
       return Eigen::Vector3d::Zero();
     Eigen::Vector3d v;
@@ -201,70 +260,69 @@ class Reader {
       while (*tokenEnd != '\0' && !isBlank(*tokenEnd))
         ++tokenEnd;
       if (count == 3)
-        fail(kind, name, attribute + " has more than 3 numbers: '" + text + "'");
-      // A number is the whole token (strtod never reads a blank, so it cannot run past the token).
-      char* end = nullptr;
-      const double value = std::strtod(at, &end);
-      if (end != tokenEnd) {
-        fail(kind, name,
-             attribute + " '" + text + "' is not a number triple ('" + std::string(at, tokenEnd) + "')");
+        fail(kind, name, attribute.str() + " has more than 3 numbers: '" + text + "'");
+      // A number is the whole token (the token ends at a blank or the end, where strtod stops).
+      const std::optional<double> value = parseNumber(at, tokenEnd);
+      if (!value) {
+        fail(
+            kind, name,
+            attribute.str() + " '" + text + "' is not a number triple ('" + std::string(at, tokenEnd) + "')");
       }
-      if (const std::optional<std::string> why = checkRange(value))
-        fail(kind, name, attribute + " '" + text + "' " + *why);
-      v[count++] = value;
+      if (const std::optional<std::string> why = checkRange(*value))
+        fail(kind, name, attribute.str() + " '" + text + "' " + *why);
+      v[count++] = *value;
       at = tokenEnd;
     }
     if (count != 3)
-      fail(kind, name, attribute + " needs 3 numbers, got " + std::to_string(count) + ": '" + text + "'");
+      fail(kind, name,
+           attribute.str() + " needs 3 numbers, got " + std::to_string(count) + ": '" + text + "'");
     return v;
   }
 
-  Eigen::Isometry3d frame(const tinyxml2::XMLElement* e, const std::string& kind, const std::string& name,
-                          const std::string& what) const {
-    if (e == nullptr)
+  /// The frame of <e xyz rpy/>; identity when @p e is null. @p what: the element's label ("link1 origin").
+  Eigen::Isometry3d frame(Element e, std::string_view kind, const std::string& name, Label what) const {
+    if (!e)
       return Eigen::Isometry3d::Identity();
-    return makeFrame(vector(e->Attribute("xyz"), kind, name, what + " xyz"),
-                     vector(e->Attribute("rpy"), kind, name, what + " rpy"));
+    return makeFrame(vector(attributeOf(e, "xyz"), kind, name, what.then(" xyz")),
+                     vector(attributeOf(e, "rpy"), kind, name, what.then(" rpy")));
   }
 
-  /// The unit axis of <tag xyz>; @p fallback when the element is absent.
-  Eigen::Vector3d axis(const tinyxml2::XMLElement* parent, const char* tag, const std::string& kind,
-                       const std::string& name, const Eigen::Vector3d& fallback) const {
-    const tinyxml2::XMLElement* element = parent->FirstChildElement(tag);
-    if (element == nullptr)
+  /// The unit axis of @p element, <tag xyz>; @p fallback when the element is absent (null).
+  Eigen::Vector3d axis(Element element, const char* tag, std::string_view kind, const std::string& name,
+                       const Eigen::Vector3d& fallback) const {
+    if (!element)
       return fallback;
-    const char* xyz = element->Attribute("xyz");
+    const char* xyz = attributeOf(element, "xyz");
     if (xyz == nullptr)
       fail(kind, name, std::string("<") + tag + "> has no xyz");
-    const Eigen::Vector3d v = vector(xyz, kind, name, std::string(tag) + " xyz");
+    const Eigen::Vector3d v = vector(xyz, kind, name, Label{tag, " xyz"});
     if (v.norm() < tolerances::kZeroVector)
       fail(kind, name, std::string(tag) + " xyz '" + xyz + "' is the zero vector");
     return v.normalized();
   }
 
-  std::string elementName(const tinyxml2::XMLElement* e, const std::string& kind) const {
-    const char* name = e->Attribute("name");
+  std::string elementName(Element e, std::string_view kind) const {
+    const char* name = attributeOf(e, "name");
     if (name == nullptr || *name == '\0')
       fail(kind, "", "has no name");
     return name;
   }
 
-  int link(const char* name, const std::string& kind, const std::string& element,
-           const std::string& role) const {
+  int link(const char* name, std::string_view kind, const std::string& element, std::string_view role) const {
     if (name == nullptr)
-      fail(kind, element, "<" + role + "> has no link attribute");
+      fail(kind, element, "<" + std::string(role) + "> has no link attribute");
     const int index = linkIndex_.find(name, mechanism_.links);
     if (index < 0)
-      fail(kind, element, role + " '" + name + "' is not a link");
+      fail(kind, element, std::string(role) + " '" + name + "' is not a link");
     return index;
   }
 
   /// Warns about every child of a loop element that is not in @p known, and about a repeated known child.
-  void checkChildren(const tinyxml2::XMLElement* e, const std::string& kind, const std::string& name,
+  void checkChildren(Element e, const std::string& kind, const std::string& name,
                      std::initializer_list<const char*> known) {
     unsigned seen = 0;  // bit i: known[i] met
-    for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
-      const char* tag = c->Name();
+    for (Element c = firstChildElement(e); c; c = nextSiblingElement(c)) {
+      const char* tag = c.name();
       unsigned bit = 0;
       for (size_t i = 0; i < known.size(); ++i) {
         if (std::strcmp(tag, known.begin()[i]) == 0)
@@ -279,9 +337,9 @@ class Reader {
     }
   }
 
-  void warnUnknown(const tinyxml2::XMLElement* e) {
-    const std::string tag = e->Name();
-    const char* name = e->Attribute("name");
+  void warnUnknown(Element e) {
+    const std::string tag = e.name();
+    const char* name = attributeOf(e, "name");
     std::string what = "unknown element <" + tag + "> is not read";
     for (const std::string known : kKnownSorted) {
       if (squashed(known) == squashed(tag))
@@ -292,9 +350,9 @@ class Reader {
     warn(tag, name == nullptr ? "" : name, what);
   }
 
-  void readLinks(const std::vector<const tinyxml2::XMLElement*>& elements) {
-    for (const tinyxml2::XMLElement* e : elements) {
-      const char* name = e->Attribute("name");
+  void readLinks(const std::vector<Element>& elements) {
+    for (Element e : elements) {
+      const char* name = attributeOf(e, "name");
       if (name == nullptr || *name == '\0')
         fail("link", "", "has no name");
       if (linkIndex_.find(name, mechanism_.links) >= 0)
@@ -307,7 +365,7 @@ class Reader {
   }
 
   /// Refuses @p name when a connection has it already (the connection itself is added by addConnection).
-  void claimName(const std::string& kind, const std::string& name) const {
+  void claimName(std::string_view kind, const std::string& name) const {
     if (connectionIndex_.find(name, mechanism_.joints) >= 0)
       fail(kind, name, kind == "joint" ? "is defined twice" : "has the name of another joint or constraint");
   }
@@ -318,19 +376,21 @@ class Reader {
     mechanism_.joints.push_back(std::move(joint));
   }
 
-  void readTreeJoints(const std::vector<const tinyxml2::XMLElement*>& elements) {
+  void readTreeJoints(const std::vector<Element>& elements) {
     parentOf_.assign(mechanism_.links.size(), -1);
-    for (const tinyxml2::XMLElement* e : elements) {
+    for (Element e : elements) {
       std::string name = elementName(e, "joint");
       claimName("joint", name);
-      const tinyxml2::XMLElement* parent = e->FirstChildElement("parent");
-      const tinyxml2::XMLElement* child = e->FirstChildElement("child");
-      if (parent == nullptr || parent->Attribute("link") == nullptr)
+      const auto [parent, child, origin, axisElement, mimic] =
+          childrenNamed<5>(e, {"parent", "child", "origin", "axis", "mimic"});
+      const char* parentName = parent ? attributeOf(parent, "link") : nullptr;
+      const char* childName = child ? attributeOf(child, "link") : nullptr;
+      if (parentName == nullptr)
         fail("joint", name, "has no <parent link=\"...\">");
-      if (child == nullptr || child->Attribute("link") == nullptr)
+      if (childName == nullptr)
         fail("joint", name, "has no <child link=\"...\">");
-      const int parentLink = link(parent->Attribute("link"), "joint", name, "parent");
-      const int childLink = link(child->Attribute("link"), "joint", name, "child");
+      const int parentLink = link(parentName, "joint", name, "parent");
+      const int childLink = link(childName, "joint", name, "child");
       if (parentLink == childLink)
         fail("joint", name, "joins link '" + mechanism_.links[childLink].name + "' to itself");
       if (parentOf_[childLink] >= 0) {
@@ -338,7 +398,7 @@ class Reader {
              "link '" + mechanism_.links[childLink].name +
                  "' already has a parent joint; close loops with <loop_joint>");
       }
-      const char* type = e->Attribute("type");
+      const char* type = attributeOf(e, "type");
       const std::optional<JointType> jointType = parseTreeType(type == nullptr ? "" : type);
       if (!jointType) {
         fail("joint", name,
@@ -350,33 +410,33 @@ class Reader {
       joint.type = *jointType;
       joint.link1 = parentLink;
       joint.link2 = childLink;
-      if (const tinyxml2::XMLElement* origin = e->FirstChildElement("origin")) {
+      if (origin) {
         joint.frame1 =
-            io_detail::makeOriginFrame(vector(origin->Attribute("xyz"), "joint", name, "origin xyz"),
-                                       vector(origin->Attribute("rpy"), "joint", name, "origin rpy"));
+            io_detail::makeOriginFrame(vector(attributeOf(origin, "xyz"), "joint", name, "origin xyz"),
+                                       vector(attributeOf(origin, "rpy"), "joint", name, "origin rpy"));
       }
       if (joint.type != JointType::Fixed && joint.type != JointType::Floating) {
         // URDF's default, but a forgotten axis turns a planar linkage spatial: said, never silent.
-        if (e->FirstChildElement("axis") == nullptr) {
+        if (!axisElement) {
           warn("joint", name,
                std::string("type ") + toString(joint.type) +
                    " has no <axis>; axis defaulted to 1 0 0 (URDF's default)");
         }
-        joint.axis = axis(e, "axis", "joint", name, Eigen::Vector3d::UnitX());
+        joint.axis = axis(axisElement, "axis", "joint", name, Eigen::Vector3d::UnitX());
       }
-      if (const tinyxml2::XMLElement* mimic = e->FirstChildElement("mimic")) {
+      if (mimic) {
         PendingCoupling coupling;
         coupling.name = "mimic_" + name;
         coupling.kind = "joint";
         coupling.follower = name;
-        const char* leader = mimic->Attribute("joint");
+        const char* leader = attributeOf(mimic, "joint");
         if (leader == nullptr)
           fail("joint", name, "<mimic> has no joint attribute");
         coupling.leader = leader;
-        if (mimic->Attribute("multiplier"))
-          coupling.multiplier = number(mimic->Attribute("multiplier"), "joint", name, "mimic multiplier");
-        if (mimic->Attribute("offset"))
-          coupling.offset = number(mimic->Attribute("offset"), "joint", name, "mimic offset");
+        if (attributeOf(mimic, "multiplier"))
+          coupling.multiplier = number(attributeOf(mimic, "multiplier"), "joint", name, "mimic multiplier");
+        if (attributeOf(mimic, "offset"))
+          coupling.offset = number(attributeOf(mimic, "offset"), "joint", name, "mimic offset");
         couplings_.push_back(std::move(coupling));
       }
       parentOf_[childLink] = parentLink;
@@ -422,28 +482,27 @@ class Reader {
 
   /// One end of a loop element: <tag link xyz rpy/> (our dialect) or <tag link><origin xyz rpy/></tag>
   /// (URDF+).
-  std::pair<int, Eigen::Isometry3d> end(const tinyxml2::XMLElement* e, const char* tag,
-                                        const std::string& kind, const std::string& name) const {
-    const tinyxml2::XMLElement* endElement = e->FirstChildElement(tag);
-    if (endElement == nullptr)
+  std::pair<int, Eigen::Isometry3d> end(Element e, const char* tag, const std::string& kind,
+                                        const std::string& name) const {
+    Element endElement = e.child(tag);
+    if (!endElement)
       fail(kind, name, std::string("missing <") + tag + ">");
-    const int l = link(endElement->Attribute("link"), kind, name, tag);
-    const tinyxml2::XMLElement* origin = endElement->FirstChildElement("origin");
-    if (origin != nullptr)
-      return {l, frame(origin, kind, name, std::string(tag) + " origin")};
-    return {l, makeFrame(vector(endElement->Attribute("xyz"), kind, name, std::string(tag) + " xyz"),
-                         vector(endElement->Attribute("rpy"), kind, name, std::string(tag) + " rpy"))};
+    const int l = link(attributeOf(endElement, "link"), kind, name, tag);
+    Element origin = endElement.child("origin");
+    if (origin)
+      return {l, frame(origin, kind, name, Label{tag, " origin"})};
+    return {l, makeFrame(vector(attributeOf(endElement, "xyz"), kind, name, Label{tag, " xyz"}),
+                         vector(attributeOf(endElement, "rpy"), kind, name, Label{tag, " rpy"}))};
   }
 
-  void readEnds(const tinyxml2::XMLElement* e, const char* tag1, const char* tag2, const std::string& kind,
-                Joint& joint) const {
+  void readEnds(Element e, const char* tag1, const char* tag2, const std::string& kind, Joint& joint) const {
     std::tie(joint.link1, joint.frame1) = end(e, tag1, kind, joint.name);
     std::tie(joint.link2, joint.frame2) = end(e, tag2, kind, joint.name);
     if (joint.link1 == joint.link2)
       fail(kind, joint.name, "joins link '" + mechanism_.links[joint.link1].name + "' to itself");
   }
 
-  void readTwoEnded(const tinyxml2::XMLElement* e, ConnectionKind kind) {
+  void readTwoEnded(Element e, ConnectionKind kind) {
     const std::string kindName = toString(kind);
     Joint joint;
     joint.name = elementName(e, kindName);
@@ -452,28 +511,28 @@ class Reader {
     joint.type = JointType::Spherical;
     checkChildren(e, kindName, joint.name, {"link1", "link2"});
     if (kind == ConnectionKind::Cable) {
-      const char* type = e->Attribute("type");
+      const char* type = attributeOf(e, "type");
       const std::string typeText = type == nullptr ? "passive" : type;
       if (typeText != "passive" && typeText != "active")
         fail("cable", joint.name, "type '" + typeText + "' is neither passive nor active");
       joint.cableType = typeText == "active" ? CableType::Active : CableType::Passive;
-      joint.length = number(e->Attribute("length"), "cable", joint.name, "length");
+      joint.length = number(attributeOf(e, "length"), "cable", joint.name, "length");
       if (joint.length <= 0.0)
-        fail("cable", joint.name, "length must be positive, got " + std::string(e->Attribute("length")));
+        fail("cable", joint.name, "length must be positive, got " + std::string(attributeOf(e, "length")));
     }
     readEnds(e, "link1", "link2", kindName, joint);
     addConnection(std::move(joint));
   }
 
   /// <loop_joint> of our dialect (Isaac Sim, Drake) or URDF+ <loop>: the same connection, two spellings.
-  void readLoop(const tinyxml2::XMLElement* e) {
-    const std::string kind = e->Name();
+  void readLoop(Element e) {
+    const std::string kind = e.name();
     const bool urdfPlus = kind == "loop";
     Joint joint;
     joint.name = elementName(e, kind);
     claimName(kind, joint.name);
     joint.kind = ConnectionKind::LoopJoint;
-    const char* type = e->Attribute("type");
+    const char* type = attributeOf(e, "type");
     const std::optional<JointType> loopType = parseLoopType(type == nullptr ? "" : type);
     if (!loopType)
       fail(kind, joint.name,
@@ -486,47 +545,48 @@ class Reader {
       checkChildren(e, kind, joint.name, {"link1", "link2", "axis", "axis2", "limit", "dynamics"});
       readEnds(e, "link1", "link2", kind, joint);
     }
-    if (needsAxis(joint.type) && e->FirstChildElement("axis") == nullptr) {
+    const auto [axisElement, axis2Element] = childrenNamed<2>(e, {"axis", "axis2"});
+    if (needsAxis(joint.type) && !axisElement) {
       warn(kind, joint.name,
            std::string("type ") + toString(joint.type) + " has no <axis>; axis defaulted to 1 0 0");
     }
-    if (joint.type == JointType::Universal && e->FirstChildElement("axis2") == nullptr) {
+    if (joint.type == JointType::Universal && !axis2Element) {
       warn(kind, joint.name, "type universal has no <axis2>; axis2 defaulted to 0 1 0");
     }
-    joint.axis = axis(e, "axis", kind, joint.name, Eigen::Vector3d::UnitX());
-    joint.axis2 = axis(e, "axis2", kind, joint.name, Eigen::Vector3d::UnitY());
+    joint.axis = axis(axisElement, "axis", kind, joint.name, Eigen::Vector3d::UnitX());
+    joint.axis2 = axis(axis2Element, "axis2", kind, joint.name, Eigen::Vector3d::UnitY());
     if (joint.type == JointType::Universal && joint.axis.cross(joint.axis2).norm() < tolerances::kPlanarAxis)
       fail(kind, joint.name, "universal joint axes 'axis' and 'axis2' are parallel");
     addConnection(std::move(joint));
   }
 
   /// URDF+ <coupling>: successor = ratio * predecessor + offset.
-  void readCoupling(const tinyxml2::XMLElement* e) {
+  void readCoupling(Element e) {
     PendingCoupling coupling;
     coupling.kind = "coupling";
     coupling.name = elementName(e, "coupling");
     checkChildren(e, "coupling", coupling.name,
                   {"predecessor", "successor", "leader", "follower", "ratio", "offset"});
     auto jointOf = [&](const char* first, const char* second) -> std::string {
-      const tinyxml2::XMLElement* c = e->FirstChildElement(first);
-      if (c == nullptr)
-        c = e->FirstChildElement(second);
-      if (c == nullptr)
+      Element c = e.child(first);
+      if (!c)
+        c = e.child(second);
+      if (!c)
         fail("coupling", coupling.name,
              std::string("missing <") + first + " joint=\"...\"> (or <" + second + ">)");
-      const char* joint = c->Attribute("joint");
+      const char* joint = attributeOf(c, "joint");
       if (joint == nullptr)
-        fail("coupling", coupling.name, std::string("<") + c->Name() + "> has no joint attribute");
+        fail("coupling", coupling.name, std::string("<") + c.name() + "> has no joint attribute");
       return joint;
     };
     coupling.leader = jointOf("predecessor", "leader");
     coupling.follower = jointOf("successor", "follower");
-    const tinyxml2::XMLElement* ratio = e->FirstChildElement("ratio");
-    if (ratio == nullptr)
+    Element ratio = e.child("ratio");
+    if (!ratio)
       fail("coupling", coupling.name, "missing <ratio value=\"...\">");
-    coupling.multiplier = number(ratio->Attribute("value"), "coupling", coupling.name, "ratio value");
-    if (const tinyxml2::XMLElement* offset = e->FirstChildElement("offset"))
-      coupling.offset = number(offset->Attribute("value"), "coupling", coupling.name, "offset value");
+    coupling.multiplier = number(attributeOf(ratio, "value"), "coupling", coupling.name, "ratio value");
+    if (Element offset = e.child("offset"))
+      coupling.offset = number(attributeOf(offset, "value"), "coupling", coupling.name, "offset value");
     couplings_.push_back(std::move(coupling));
   }
 
@@ -571,15 +631,108 @@ class Reader {
 
 namespace {
 
-/// The mechanism of a parsed document (@p parsed: the parser's answer).
-Result<Mechanism> readDocument(const tinyxml2::XMLDocument& document, tinyxml2::XMLError parsed,
-                               const std::string& file) {
-  if (parsed != tinyxml2::XML_SUCCESS) {
-    const char* error = document.ErrorStr();
-    return makeDiagnostic(file, "xml", "", std::string("not well-formed XML: ") + (error ? error : "?"));
+/// pugixml reads text as tinyxml2 did: entities and character references decoded, CDATA kept, line ends
+/// normalised to '\n', attribute blanks kept as written (no parse_wconv_attribute: a tab in a name stays a
+/// tab). parse_fragment keeps top-level text as nodes so that it can be refused (wellFormedError), and
+/// makes an element-less document parse: refused there as well.
+constexpr unsigned kParseOptions =
+    pugi::parse_cdata | pugi::parse_escapes | pugi::parse_eol | pugi::parse_fragment;
+
+/// The 1-based line of byte @p offset of @p text (the text as written, before the parser changed it); an
+/// offset at or past the end (pugixml's for an unclosed element) is on the last line.
+size_t lineAt(const std::string& text, ptrdiff_t offset) {
+  const size_t last = text.empty() ? 0 : text.size() - 1;
+  const size_t end = offset < 0 ? 0 : std::min(last, static_cast<size_t>(offset));
+  return 1 + static_cast<size_t>(std::count(text.begin(), text.begin() + end, '\n'));
+}
+
+/// Where a parsed document breaks XML's well-formedness in what pugixml accepts and tinyxml2 refused.
+struct XmlFault {
+  std::string what;
+  ptrdiff_t offset = -1;  ///< Into the text as written; -1: unknown.
+};
+
+/// The first attribute of @p e named like an earlier one of @p e, or a null attribute. Most elements have one
+/// or two attributes: their names are gathered once and compared there (pugixml's accessors are calls into
+/// the shared library).
+pugi::xml_attribute repeatedAttribute(Element e) {
+  pugi::xml_attribute a = e.first_attribute();
+  if (!a || !a.next_attribute())
+    return pugi::xml_attribute();
+  constexpr int kGathered = 8;
+  const char* names[kGathered];
+  int count = 0;
+  for (; a; a = a.next_attribute()) {
+    const char* name = a.name();
+    const int earlier = std::min(count, kGathered);
+    for (int i = 0; i < earlier; ++i) {
+      if (names[i][0] == name[0] && std::strcmp(names[i], name) == 0)
+        return a;
+    }
+    if (count >= kGathered) {  // beyond the gathered names: through pugixml
+      for (pugi::xml_attribute b = e.first_attribute(); b != a; b = b.next_attribute()) {
+        if (std::strcmp(b.name(), name) == 0)
+          return a;
+      }
+    } else {
+      names[count] = name;
+    }
+    ++count;
   }
-  const tinyxml2::XMLElement* robot = document.FirstChildElement("robot");
-  if (robot == nullptr)
+  return pugi::xml_attribute();
+}
+
+/**
+ * @brief What pugixml lets through that is not well-formed XML (XML 1.0 §2.1, §3.1): text outside the root
+ *        element, no element at all, an attribute given twice in one element; nothing when none of these.
+ *
+ * One walk over every node in document order, without recursion (nesting depth is the input's to choose).
+ */
+std::optional<XmlFault> wellFormedError(const pugi::xml_document& document) {
+  bool anyElement = false;
+  for (Element top = document.first_child(); top; top = top.next_sibling()) {
+    if (top.type() == pugi::node_pcdata || top.type() == pugi::node_cdata)
+      return XmlFault{"text outside the root element", top.offset_debug()};
+    anyElement = anyElement || top.type() == pugi::node_element;
+  }
+  if (!anyElement)
+    return XmlFault{"No document element found", -1};
+  // pugixml's own walk (iterative, inside the library: a third faster than stepping with its accessors).
+  struct RepeatedAttributes : pugi::xml_tree_walker {
+    std::optional<XmlFault> fault;
+    bool for_each(pugi::xml_node& node) override {
+      const pugi::xml_attribute repeated = repeatedAttribute(node);  // null but for elements
+      if (repeated) {
+        fault =
+            XmlFault{"attribute '" + std::string(repeated.name()) + "' given twice in <" + node.name() + ">",
+                     node.offset_debug()};
+      }
+      return !repeated;
+    }
+  } walker;
+  Element root = document.root();  // a handle: traverse is not const, but does not change the tree
+  root.traverse(walker);
+  return walker.fault;
+}
+
+/// The mechanism of a parsed document (@p parsed: pugixml's answer; @p textAsWritten() gives the text for the
+/// line of an error).
+template <class TextAsWritten>
+Result<Mechanism> readDocument(const pugi::xml_document& document, const pugi::xml_parse_result& parsed,
+                               const std::string& file, const TextAsWritten& textAsWritten) {
+  std::optional<XmlFault> fault;
+  if (!parsed)
+    fault = XmlFault{parsed.description(), parsed.offset};
+  else
+    fault = wellFormedError(document);
+  if (fault) {
+    std::string what = "not well-formed XML: " + fault->what;
+    if (fault->offset >= 0)
+      what += " at line " + std::to_string(lineAt(textAsWritten(), fault->offset));
+    return makeDiagnostic(file, "xml", "", what);
+  }
+  const Element robot = document.child("robot");
+  if (!robot)
     return makeDiagnostic(file, "xml", "", "the root element is not <robot>");
   try {
     return Reader(file).read(robot);
@@ -591,21 +744,24 @@ Result<Mechanism> readDocument(const tinyxml2::XMLDocument& document, tinyxml2::
 }  // namespace
 
 Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName) {
-  tinyxml2::XMLDocument document;
-  const tinyxml2::XMLError parsed = document.Parse(urdfText.c_str(), urdfText.size());
-  return readDocument(document, parsed, io_detail::baseName(fileName));
+  pugi::xml_document document;
+  const pugi::xml_parse_result parsed = document.load_buffer(urdfText.data(), urdfText.size(), kParseOptions);
+  return readDocument(document, parsed, io_detail::baseName(fileName),
+                      [&]() -> const std::string& { return urdfText; });
 }
 
 Result<Mechanism> readUrdfFile(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr)
-    return makeDiagnostic(path, "", "", "cannot open the file");
-  tinyxml2::XMLDocument document;
-  const tinyxml2::XMLError parsed = document.LoadFile(file);
-  std::fclose(file);
-  if (parsed == tinyxml2::XML_ERROR_FILE_READ_ERROR || parsed == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
-    return makeDiagnostic(path, "", "", "cannot open the file");  // a directory, an unreadable file
-  return readDocument(document, parsed, io_detail::baseName(path));
+  // The text once in memory: the parser works in this buffer (names and values point into it).
+  std::string text;
+  if (!io_detail::readWholeFile(path, text))
+    return makeDiagnostic(path, "", "", "cannot open the file");  // also a directory, an unreadable file
+  pugi::xml_document document;
+  const pugi::xml_parse_result parsed = document.load_buffer_inplace(&text[0], text.size(), kParseOptions);
+  std::string original;  // read again only for the line of an error: the parse changed `text`
+  return readDocument(document, parsed, io_detail::baseName(path), [&]() -> const std::string& {
+    io_detail::readWholeFile(path, original);
+    return original;
+  });
 }
 
 }  // namespace mobility_analysis
