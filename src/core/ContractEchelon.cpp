@@ -171,13 +171,11 @@ class Patches {
     // dependency of every row wanted now; otherwise the patch is eliminated again, tracing what is wanted
     // now and what was traced before, and that outcome replaces the known one.
     PatchOutcome* known = nullptr;
-    if (memo_.active()) {
+    const bool keyed = memo_.active();
+    if (keyed) {
       memo_.clearKey();
       memo_.appendKey(local);
       known = memo_.find();
-    } else {
-      eliminateWanted(local, rows, wanted, found);
-      return;
     }
     const bool serves =
         known && std::all_of(known->dependencies.begin(), known->dependencies.end(),
@@ -204,7 +202,7 @@ class Patches {
     storedEntries += outcome.storedEntries;
     if (known && !serves) {
       *known = std::move(fresh);
-    } else if (!known) {
+    } else if (keyed && !known) {
       const size_t bytes = fresh.bytes();
       memo_.insert(std::move(fresh), bytes);
     }
@@ -241,23 +239,6 @@ class Patches {
     }
     outcome.storedEntries = elimination.storedEntries();
     return outcome;
-  }
-
-  /// @p local's rows eliminated in order, only the dependent rows that @p wanted accepts traced.
-  template <class Wanted, class Found>
-  void eliminateWanted(const SparseJacobian& local, const std::vector<int>& rows, Wanted&& wanted,
-                       Found&& found) {
-    SparseElimination elimination(static_cast<int>(local.cols()), {}, tolerance_, true);
-    for (int i = 0; i < local.rows(); ++i) {
-      const double norm = local.row(i).norm();
-      if (!elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0).dependent || !wanted(rows[i]))
-        continue;
-      SelfStress stress = *elimination.traceDependency(i, elimination.multipliers());
-      for (auto& entry : stress)
-        entry.first = rows[entry.first];
-      found(rows[i], std::move(stress));
-    }
-    storedEntries += elimination.storedEntries();
   }
 
   const Mechanism& mechanism_;
