@@ -4,45 +4,17 @@
 #include <queue>
 #include <tuple>
 
+#include "Buckets.hpp"
+
 namespace mobility_analysis {
 
 namespace {
 
+using core_detail::BucketRange;
+using core_detail::Buckets;
+
 /// Connections of one link sorted by insertion, at most.
 constexpr size_t kInsertionSortMax = 16;
-
-/// Integers grouped by a key in one pooled array (compressed rows): one allocation for all keys instead of a
-/// vector per link and per joint (4 10^5 of them on a 10^5-link chain); each group keeps insertion order.
-class Buckets {
- public:
-  explicit Buckets(int numKeys) : start_(static_cast<size_t>(numKeys) + 1, 0) {}
-  /// First pass: one more value under @p key.
-  void count(int key) { ++start_[static_cast<size_t>(key) + 1]; }
-  /// After counting: room for every value counted.
-  void allocate() {
-    for (size_t k = 1; k < start_.size(); ++k)
-      start_[k] += start_[k - 1];
-    values_.resize(start_.back());
-    fill_.assign(start_.begin(), start_.end() - 1);
-  }
-  /// Second pass, in the same order as counted: the value itself.
-  void add(int key, int value) { values_[fill_[static_cast<size_t>(key)]++] = value; }
-  const int* begin(int key) const { return values_.data() + start_[static_cast<size_t>(key)]; }
-  const int* end(int key) const { return values_.data() + start_[static_cast<size_t>(key) + 1]; }
-  bool empty(int key) const { return begin(key) == end(key); }
-
- private:
-  std::vector<size_t> start_, fill_;
-  std::vector<int> values_;
-};
-
-/// A [begin, end) range of a bucket, for range-for.
-struct Range {
-  const int* first;
-  const int* last;
-  const int* begin() const { return first; }
-  const int* end() const { return last; }
-};
 
 /// The equations grouped by what releases them and the links each connection couples, read once from the
 /// model: what a sweep over the links needs, whatever the order of the links.
@@ -53,10 +25,10 @@ struct SweepGraph {
   std::vector<std::pair<int, int>> ends;
   Buckets incidentOf;
   std::vector<char> expressed;
-  Range linkRows(int l) const { return Range{rowsOf.begin(l), rowsOf.end(l)}; }
-  Range boundaryRows(int l) const { return Range{rowsOf.begin(numLinks + l), rowsOf.end(numLinks + l)}; }
-  Range jointRows(int j) const { return Range{rowsOf.begin(2 * numLinks + j), rowsOf.end(2 * numLinks + j)}; }
-  Range incident(int l) const { return Range{incidentOf.begin(l), incidentOf.end(l)}; }
+  BucketRange linkRows(int l) const { return rowsOf[l]; }
+  BucketRange boundaryRows(int l) const { return rowsOf[numLinks + l]; }
+  BucketRange jointRows(int j) const { return rowsOf[2 * numLinks + j]; }
+  BucketRange incident(int l) const { return incidentOf[l]; }
   int otherEnd(int joint, int link) const {
     const std::pair<int, int>& e = ends[static_cast<size_t>(joint)];
     return e.first == link ? e.second : e.first;
@@ -95,7 +67,7 @@ SweepGraph::SweepGraph(const Mechanism& mechanism, const CoordinateModel& model)
   // Only connections with equations couple their links: a floating joint (a link held by loop joints alone)
   // or a slack cable would let the sweep jump from the ground straight into the middle of the mechanism.
   auto couples = [&](int j) {
-    return !rowsOf.empty(2 * numLinks + j) &&
+    return !rowsOf[2 * numLinks + j].empty() &&
            ends[static_cast<size_t>(j)].first != ends[static_cast<size_t>(j)].second;
   };
   for (int j = 0; j < numJoints; ++j) {

@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include "../Buckets.hpp"
 #include "mobility_analysis/coordinates/EquationForms.hpp"
 
 namespace mobility_analysis {
@@ -69,16 +70,6 @@ bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
   return std::isfinite(inverseNorm) && inverseNorm > 0.0 && std::sqrt(1.0 / inverseNorm) > bound;
 }
 
-/// A link's connections: a range in one pooled array (one allocation for all links, not one per link).
-struct ConnectionRange {
-  const int* first;
-  const int* last;
-  const int* begin() const { return first; }
-  const int* end() const { return last; }
-  size_t size() const { return static_cast<size_t>(last - first); }
-  int operator[](size_t i) const { return first[i]; }
-};
-
 /// The mechanism at the pose q as the search reads it: the connections that constrain at each link, each
 /// Jacobian row's norm, and the rows of T (the twist of a rigid group mapped onto its coordinates).
 struct SearchContext {
@@ -102,18 +93,14 @@ struct SearchContext {
   const bool planar;
   const int lambda;
   /// Per link, the connections that constrain it (in connection order).
-  ConnectionRange connectionsAt(int l) const {
-    return ConnectionRange{connections_.data() + connectionStart_[static_cast<size_t>(l)],
-                           connections_.data() + connectionStart_[static_cast<size_t>(l) + 1]};
-  }
+  core_detail::BucketRange connectionsAt(int l) const { return connections_[l]; }
   std::vector<std::pair<int, int>> jointEnds;  ///< Per connection, link1 and link2 (read once: a Joint is
                                                ///< hundreds of bytes).
   std::vector<double> rowNorm;                 ///< Per row of J, its norm.
   std::vector<int> jointOfRow;                 ///< Per row of J, its connection (-1: a link's, the ground's).
 
  private:
-  std::vector<size_t> connectionStart_;  // per link, into connections_ (compressed rows)
-  std::vector<int> connections_;
+  core_detail::Buckets connections_;  // per link
 };
 
 SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& model,
@@ -128,7 +115,7 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
       lambda(model.lambda),
       jointEnds(mechanism.joints.size()),
       rowNorm(static_cast<size_t>(J.rows())),
-      connectionStart_(static_cast<size_t>(numLinks) + 1, 0) {
+      connections_(numLinks) {
   // Connections that constrain, and the links they join (a connection joining a link to itself is listed
   // twice there, as before).
   // (One read of the equations, 110 bytes each, for the bound's rows too.)
@@ -145,18 +132,15 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
     jointEnds[j] = {mechanism.joints[j].link1, mechanism.joints[j].link2};
     if (equationsOf[j] == 0)
       continue;
-    ++connectionStart_[static_cast<size_t>(jointEnds[j].first) + 1];
-    ++connectionStart_[static_cast<size_t>(jointEnds[j].second) + 1];
+    connections_.count(jointEnds[j].first);
+    connections_.count(jointEnds[j].second);
   }
-  for (size_t l = 1; l < connectionStart_.size(); ++l)
-    connectionStart_[l] += connectionStart_[l - 1];
-  connections_.resize(connectionStart_.back());
-  std::vector<size_t> fill(connectionStart_.begin(), connectionStart_.end() - 1);
+  connections_.allocate();
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     if (equationsOf[j] == 0)
       continue;
-    connections_[fill[static_cast<size_t>(jointEnds[j].first)]++] = static_cast<int>(j);
-    connections_[fill[static_cast<size_t>(jointEnds[j].second)]++] = static_cast<int>(j);
+    connections_.add(jointEnds[j].first, static_cast<int>(j));
+    connections_.add(jointEnds[j].second, static_cast<int>(j));
   }
   // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
   for (Eigen::Index r = 0; r < J.rows(); ++r)
@@ -291,7 +275,8 @@ void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
       connection >= 0 ? &context_.jointEnds[static_cast<size_t>(connection)] : nullptr;
   bool twoLinks = joint != nullptr && !parts.overflow;
   for (size_t s = 0; s < parts.used; ++s)
-    twoLinks = twoLinks && (parts.perLink[s].first == joint->first || parts.perLink[s].first == joint->second);
+    twoLinks =
+        twoLinks && (parts.perLink[s].first == joint->first || parts.perLink[s].first == joint->second);
   for (size_t s = 0; s < parts.used; ++s) {
     const int l = parts.perLink[s].first;
     linkFrobenius_[static_cast<size_t>(l)] +=
@@ -319,7 +304,7 @@ void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
 }
 
 int EndConnectionBound::slotOf(int link, int joint) const {
-  const ConnectionRange at = context_.connectionsAt(link);
+  const core_detail::BucketRange at = context_.connectionsAt(link);
   return at.size() != 2 ? -1 : at[0] == joint ? 0 : at[1] == joint ? 1 : -1;
 }
 
