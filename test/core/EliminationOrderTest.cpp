@@ -9,7 +9,6 @@
 #include <gtest/gtest.h>
 
 #include "core/TestModels.hpp"
-#include "mobility_analysis/ConstraintJacobian.hpp"
 #include "mobility_analysis/SparseElimination.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
@@ -29,11 +28,9 @@ bool isPermutation(std::vector<int> values, int size) {
 TEST(EliminationOrder, IsAPermutationReleasingJointsAfterTheirLinks) {
   for (const char* file : {"bennett.urdf", "rssr.urdf", "hoberman_ring.urdf", "door.urdf", "sle_mast.urdf"}) {
     SCOPED_TRACE(file);
-    const Mechanism mechanism = loadOrFail(urdfPath(file));
-    Result<AssembledMechanism> assembled =
-        assembleMechanism(mechanism, computeTreePoses(mechanism, {}), AnalysisMode::Spatial);
-    ASSERT_TRUE(isOk(assembled));
-    const CoordinateModel& model = valueOf(assembled).model;
+    const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath(file)), AnalysisMode::Spatial);
+    const Mechanism& mechanism = m.mechanism;
+    const CoordinateModel& model = m.assembled.model;
     const EliminationOrder order = computeSweepOrder(mechanism, model);
     ASSERT_TRUE(isPermutation(order.rows, model.numConstraints()));
     ASSERT_TRUE(isPermutation(order.columnPriority, model.numCoordinates()));
@@ -93,12 +90,10 @@ TEST(EliminationOrder, AnyOrderOfTheLinksIsBuiltLikeTheSweep) {
   // Jacobian's rank (which no order changes) found again by the elimination the self-stress basis uses.
   for (const char* file : {"bennett.urdf", "rssr.urdf", "hoberman_ring.urdf", "door.urdf", "sle_mast.urdf"}) {
     SCOPED_TRACE(file);
-    const Mechanism mechanism = loadOrFail(urdfPath(file));
-    Result<AssembledMechanism> assembled =
-        assembleMechanism(mechanism, computeTreePoses(mechanism, {}), AnalysisMode::Spatial);
-    ASSERT_TRUE(isOk(assembled));
-    const CoordinateModel& model = valueOf(assembled).model;
-    const SparseJacobian J = computeConstraintJacobian(model, valueOf(assembled).q);
+    const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath(file)), AnalysisMode::Spatial);
+    const Mechanism& mechanism = m.mechanism;
+    const CoordinateModel& model = m.assembled.model;
+    const SparseJacobian& J = m.J;
     const EliminationOrder sweep = computeSweepOrder(mechanism, model);
 
     // The sweep's link order: links by the first pivot priority of their coordinates.
