@@ -74,6 +74,21 @@ double cpuSeconds() {
 constexpr const char* kUsage =
     "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|load|slvs|orders FILE.urdf [--mode M] [--budget S] [--orientation auto|J|JT]";
 
+/// The mechanism assembled from its tree pose and the constraint Jacobian there: what the baselines (spqr,
+/// dense, literal, orders) are handed, built outside their timed regions.
+struct JacobianAtTreePose {
+  AssembledMechanism assembled;
+  SparseJacobian J;
+};
+
+Result<JacobianAtTreePose> jacobianAtTreePose(const Mechanism& mechanism, AnalysisMode mode) {
+  Result<AssembledMechanism> assembled = assembleMechanism(mechanism, computeTreePoses(mechanism, {}), mode);
+  if (!isOk(assembled)) return diagnosticOf(assembled);
+  JacobianAtTreePose at{valueOf(std::move(assembled)), {}};
+  at.J = computeConstraintJacobian(at.assembled.model, at.assembled.q);
+  return at;
+}
+
 int fail(const std::string& line) {
   std::cerr << line << std::endl;
   return 2;
@@ -233,11 +248,9 @@ int main(int argc, char** argv) {
   } else if (method == "orders") {
 #ifdef MA_HAVE_AMD
     // Issue 13, item 2: the sweep's elimination order against a fill-reducing order of the link graph.
-    const Result<AssembledMechanism> assembled =
-        assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
-    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
-    const SparseJacobian J = computeConstraintJacobian(valueOf(assembled).model, valueOf(assembled).q);
-    return printEliminationOrders(valueOf(mechanism), valueOf(assembled).model, J, file);
+    const Result<JacobianAtTreePose> at = jacobianAtTreePose(valueOf(mechanism), valueOf(mode));
+    if (!isOk(at)) return fail(diagnosticOf(at).toString());
+    return printEliminationOrders(valueOf(mechanism), valueOf(at).assembled.model, valueOf(at).J, file);
 #else
     status = "unsupported";
     std::cerr << "mobility_benchmark was built without SuiteSparse AMD" << std::endl;
@@ -245,10 +258,9 @@ int main(int argc, char** argv) {
   } else if (method == "spqr") {
     // One sparse rank-revealing QR of the same Jacobian the full report ranks, built and row-normalised outside
     // the timed region (as for dense): the lower bound for any sparse rank answer.
-    const Result<AssembledMechanism> assembled =
-        assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
-    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
-    SparseJacobian J = computeConstraintJacobian(valueOf(assembled).model, valueOf(assembled).q);
+    Result<JacobianAtTreePose> at = jacobianAtTreePose(valueOf(mechanism), valueOf(mode));
+    if (!isOk(at)) return fail(diagnosticOf(at).toString());
+    SparseJacobian J = valueOf(std::move(at)).J;
     n = static_cast<int>(J.cols());
     m = static_cast<int>(J.rows());
 #ifdef MA_HAVE_SPQR
@@ -294,10 +306,9 @@ int main(int argc, char** argv) {
 #endif
   } else {
     // The same Jacobian the full report uses, built outside the timed region for the baselines.
-    const Result<AssembledMechanism> assembled =
-        assembleMechanism(valueOf(mechanism), computeTreePoses(valueOf(mechanism), {}), valueOf(mode));
-    if (!isOk(assembled)) return fail(diagnosticOf(assembled).toString());
-    const SparseJacobian J = computeConstraintJacobian(valueOf(assembled).model, valueOf(assembled).q);
+    const Result<JacobianAtTreePose> at = jacobianAtTreePose(valueOf(mechanism), valueOf(mode));
+    if (!isOk(at)) return fail(diagnosticOf(at).toString());
+    const SparseJacobian& J = valueOf(at).J;
     n = static_cast<int>(J.cols());
     m = static_cast<int>(J.rows());
     const double denseBytes = 8.0 * n * m;
