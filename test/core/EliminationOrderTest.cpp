@@ -23,10 +23,14 @@ bool isPermutation(std::vector<int> values, int size) {
   return values == expected;
 }
 
+/// Loops of every kind: a spatial over-constrained loop, balls, a planar ring, a door, a scissor mast.
+const std::vector<const char*> kModels = {"bennett.urdf", "rssr.urdf", "hoberman_ring.urdf", "door.urdf",
+                                          "sle_mast.urdf"};
+
 }  // namespace
 
 TEST(EliminationOrder, IsAPermutationReleasingJointsAfterTheirLinks) {
-  for (const char* file : {"bennett.urdf", "rssr.urdf", "hoberman_ring.urdf", "door.urdf", "sle_mast.urdf"}) {
+  for (const char* file : kModels) {
     SCOPED_TRACE(file);
     const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath(file)), AnalysisMode::Spatial);
     const Mechanism& mechanism = m.mechanism;
@@ -88,7 +92,7 @@ TEST(EliminationOrder, AnyOrderOfTheLinksIsBuiltLikeTheSweep) {
   // way the sweep does: given the sweep's own link order it returns the sweep's order, and given any order a
   // permutation of the equations and coordinates in which each connection comes after its links, with the
   // Jacobian's rank (which no order changes) found again by the elimination the self-stress basis uses.
-  for (const char* file : {"bennett.urdf", "rssr.urdf", "hoberman_ring.urdf", "door.urdf", "sle_mast.urdf"}) {
+  for (const char* file : kModels) {
     SCOPED_TRACE(file);
     const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath(file)), AnalysisMode::Spatial);
     const Mechanism& mechanism = m.mechanism;
