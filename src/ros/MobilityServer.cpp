@@ -13,7 +13,7 @@
 #include "mobility_analysis/Kinematics.hpp"
 #include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/motion/Deployment.hpp"
-#include "mobility_analysis/ros/DriveableJoints.hpp"
+#include "mobility_analysis/analysis/DriveableJoints.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
 
 namespace mobility_analysis {

@@ -12,7 +12,6 @@
 
 #include "mobility_analysis/mobility_analysis.hpp"
 #include "mobility_analysis/motion/Deployment.hpp"
-#include "mobility_analysis/ros/DriveableJoints.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
 
 using namespace mobility_analysis;
@@ -529,22 +528,6 @@ TEST(RosMessageConversion, aLinkWithManyJointsIsAStarNotEveryPair) {
     }
   }
   EXPECT_TRUE(found);
-}
-
-TEST(DriveableJoints, oneJointPerFreeDirectionInDocumentOrder) {
-  // DOF 1 loops: the first tree joint drives; RSSR (DOF 2): the crank drives, the rod's spin moves no joint;
-  // PUMA 560: every one of its six joints.
-  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
-      {"four_bar.urdf", {"ground_crank"}}, {"bennett.urdf", {"j1"}}, {"rssr.urdf", {"r1"}}};
-  for (AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial}) {
-    for (const auto& [file, expected] : cases) {
-      SCOPED_TRACE(file);
-      const Analysed a = analyse(std::string(MA_URDF_DIR) + "/" + file, mode);
-      EXPECT_EQ(findDriveableJoints(a.mechanism, a.analysis), expected);
-    }
-  }
-  const Analysed puma = analyse(std::string(MA_URDF_DIR) + "/puma560.urdf", AnalysisMode::Spatial);
-  EXPECT_EQ(findDriveableJoints(puma.mechanism, puma.analysis).size(), 6u);
 }
 
 TEST(RosMessageConversion, failureCarriesTheDiagnostic) {

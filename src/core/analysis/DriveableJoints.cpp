@@ -1,4 +1,4 @@
-#include "mobility_analysis/ros/DriveableJoints.hpp"
+#include "mobility_analysis/analysis/DriveableJoints.hpp"
 
 #include <Eigen/QR>
 
