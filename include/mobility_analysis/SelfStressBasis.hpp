@@ -13,6 +13,16 @@
 
 namespace mobility_analysis {
 
+/// A set of stresses reduced to echelon form on their last equations in contract order
+/// (computeOrderedRankFromStresses): the pivots are the redundant equations.
+struct StressEchelon {
+  std::vector<char> pivot;  ///< Per equation: a pivot of the reduction (the equation is redundant).
+  int rank = 0;
+  double smallestKeptPivot = 0.0;
+  double largestDroppedResidual = 0.0;
+  double tolerance = 0.0;  ///< The threshold it was made with.
+};
+
 /**
  * @brief A basis of the left null space of the constraint Jacobian: its self-stresses.
  *
@@ -38,6 +48,10 @@ struct SelfStressBasis {
   /// when the sweep's stresses would fill their reduction to that form; else empty. The ordered redundancy
   /// is read off it (computeOrderedRankFromStresses).
   std::vector<SelfStress> contractEchelon;
+  /// The reduction of `stresses` to echelon form, where computeSelfStressBasis already made it to decide
+  /// whether contractEchelon is needed (computeOrderedRankFromStresses then reads it instead of reducing
+  /// again, at the same tolerance); else empty. Whoever changes `stresses` afterwards must reset it.
+  std::optional<StressEchelon> echelon;
   static constexpr size_t kMaxMotions = 256;
 };
 

@@ -38,9 +38,11 @@ constexpr size_t kFillFactor = 8;
 constexpr size_t kFillFloor = 1000000;
 
 /// The sweep's stresses are reduced to contract-order echelon form directly while the reduction stores at
-/// most this many times their entries, plus kEchelonFillFloor; past that, local stresses are found
+/// most this many times their entries, plus kEchelonFillFloor, and at most kEchelonRunningFactor times the
+/// entries of the rows it has taken so far, plus the same floor; past either, local stresses are found
 /// (findContractEchelon).
 constexpr size_t kEchelonFillFactor = 2;
+constexpr size_t kEchelonRunningFactor = 8;
 constexpr size_t kEchelonFillFloor = 100000;
 
 /// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
@@ -585,26 +587,21 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
   return basis;
 }
 
-/// The echelon form of a set of stresses on their last equations (computeOrderedRankFromStresses).
-struct StressReduction {
-  std::vector<char> pivot;  ///< Per equation: a pivot of the reduction (the equation is redundant).
-  int rank = 0;
-  double smallestKeptPivot = 0.0;
-  double largestDroppedResidual = 0.0;
-};
-
 /**
  * The rows of Y (one column per stress) from the last equation up, each kept when it is independent of the
  * rows after it: the kept ones are the stresses' last equations once reduced to echelon form.
- * @param[in] fillBudget give up (return nothing) once the reduction has stored more entries than this; 0: no
- * limit.
+ * @param[in] limited give up (return nothing) once the reduction has stored more entries than
+ * kEchelonFillFactor times the stresses' entries, or than kEchelonRunningFactor times the entries of the rows
+ * taken so far (each plus kEchelonFillFloor); false: no limit.
  */
-std::optional<StressReduction> reduceStresses(const std::vector<SelfStress>& stresses, int m,
-                                              double tolerance, size_t fillBudget) {
+std::optional<StressEchelon> reduceStresses(const std::vector<SelfStress>& stresses, int m, double tolerance,
+                                            bool limited) {
   const int numStresses = static_cast<int>(stresses.size());
   std::vector<Eigen::Triplet<double>> triplets;
   std::vector<int> enters(numStresses, -1);  // the stress's last row: where the upward sweep meets it
+  size_t entries = 0;
   for (int s = 0; s < numStresses; ++s) {
+    entries += stresses[s].size();
     for (const auto& [row, value] : stresses[s]) {
       triplets.emplace_back(row, s, value);
       enters[s] = std::max(enters[s], row);
@@ -629,12 +626,21 @@ std::optional<StressReduction> reduceStresses(const std::vector<SelfStress>& str
   for (int k = 0; k < numStresses; ++k)
     columnPriority[byEntering[k]] = k;
   SparseElimination elimination(numStresses, std::move(columnPriority), tolerance, false);
-  StressReduction reduction;
+  StressEchelon reduction;
+  reduction.tolerance = tolerance;
   reduction.pivot.assign(m, 0);
+  // Why a running budget beside the total: where the reduction fills (a braced lattice) its fill grows as
+  // the square of the rows taken, and the total budget is passed only after most of that square has been
+  // paid: at 50 x 50 it stored 20 times the entries of the rows taken after 4 000 of them, and passed the
+  // total 1 850 rows later. Where it does not (grids of continuous bars) it stays within 3.3 times.
+  const size_t totalBudget = kEchelonFillFactor * entries + kEchelonFillFloor;
+  size_t taken = 0;
   for (int r = m - 1; r >= 0 && elimination.rank() < numStresses; --r) {
-    if (fillBudget > 0 && elimination.storedEntries() > fillBudget)
+    const size_t stored = elimination.storedEntries();
+    if (limited && (stored > totalBudget || stored > kEchelonRunningFactor * taken + kEchelonFillFloor))
       return std::nullopt;
     reduction.pivot[r] = elimination.addRow(Y, r, 1.0).dependent ? 0 : 1;
+    taken += static_cast<size_t>(Y.outerIndexPtr()[r + 1] - Y.outerIndexPtr()[r]);
   }
   reduction.rank = elimination.rank();
   reduction.smallestKeptPivot = elimination.smallestKeptPivot();
@@ -720,21 +726,22 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
   // they share last equations (on a lattice of bars braced by cables they combine along whole rows of cells:
   // 1.2 10^6 entries and 5.5 s at 50 x 50, far past a minute at 100 x 100). Where the reduction passes its
   // budget, stresses local in contract order are found instead, and the reduction of those does not fill.
-  size_t entries = 0;
+  // A reduction that stays within its budget is the one the ordered rank needs: it is kept (basis.echelon).
   bool ownLastRows = true;
   std::vector<char> isLast(J.rows(), 0);
   for (const SelfStress& stress : basis.stresses) {
-    entries += stress.size();
     if (!stress.empty()) {
       ownLastRows = ownLastRows && isLast[stress.back().first] == 0;
       isLast[stress.back().first] = 1;
     }
   }
-  if (!ownLastRows && !reduceStresses(basis.stresses, static_cast<int>(J.rows()), tolerance,
-                                      kEchelonFillFactor * entries + kEchelonFillFloor)) {
-    if (std::optional<std::vector<SelfStress>> echelon =
-            findContractEchelon(mechanism, model, J, basis.stresses, tolerance))
-      basis.contractEchelon = std::move(*echelon);
+  if (!ownLastRows) {
+    basis.echelon = reduceStresses(basis.stresses, static_cast<int>(J.rows()), tolerance, true);
+    if (!basis.echelon) {
+      if (std::optional<std::vector<SelfStress>> echelon =
+              findContractEchelon(mechanism, model, J, basis.stresses, tolerance))
+        basis.contractEchelon = std::move(*echelon);
+    }
   }
   return basis;
 }
@@ -756,7 +763,9 @@ std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis&
       !basis.contractEchelon.empty() && basis.contractEchelon.size() == basis.stresses.size();
   const std::vector<SelfStress>& stresses = echelon ? basis.contractEchelon : basis.stresses;
   if (!stresses.empty()) {
-    const std::optional<StressReduction> reduction = reduceStresses(stresses, m, tolerance, 0);
+    const bool made = !echelon && basis.echelon && basis.echelon->tolerance == tolerance;
+    const std::optional<StressEchelon> reduction =
+        made ? basis.echelon : reduceStresses(stresses, m, tolerance, false);
     if (!reduction || reduction->rank != static_cast<int>(stresses.size()))
       return std::nullopt;
     for (int r = 0; r < m; ++r)
