@@ -3,7 +3,53 @@
 #include <algorithm>
 #include <numeric>
 
+#include "Buckets.hpp"
+#include "LocalRows.hpp"
+
 namespace mobility_analysis {
+
+namespace {
+
+/// The stresses by connection equation: Y(r, s) = stress s at joint row r (other rows empty).
+SparseJacobian stressesByJointRow(const CoordinateModel& model, const std::vector<SelfStress>& stresses) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int s = 0; s < static_cast<int>(stresses.size()); ++s) {
+    for (const auto& [row, value] : stresses[s]) {
+      if (model.equations[row].source == EquationSource::Joint)
+        triplets.emplace_back(row, s, value);
+    }
+  }
+  SparseJacobian Y(model.numConstraints(), static_cast<int>(stresses.size()));
+  Y.setFromTriplets(triplets.begin(), triplets.end());
+  return Y;
+}
+
+/// The connection equations of each link, in contract order (pooled: a vector per link cost a braced
+/// lattice's report more than the eliminations).
+core_detail::Buckets connectionRowsOfLinks(const Mechanism& mechanism, const CoordinateModel& model) {
+  core_detail::Buckets rowsOfLink(static_cast<int>(mechanism.links.size()));
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int r = 0; r < model.numConstraints(); ++r) {
+      const ConstraintEquation& eq = model.equations[r];
+      if (eq.source != EquationSource::Joint)
+        continue;
+      const Joint& joint = mechanism.joints[eq.element];
+      for (int link : {joint.link1, joint.link2}) {
+        if (link == joint.link2 && joint.link2 == joint.link1)
+          continue;
+        if (pass == 0)
+          rowsOfLink.count(link);
+        else
+          rowsOfLink.add(link, r);
+      }
+    }
+    if (pass == 0)
+      rowsOfLink.allocate();
+  }
+  return rowsOfLink;
+}
+
+}  // namespace
 
 std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const CoordinateModel& model,
                                      const std::vector<SelfStress>& stresses, double tolerance) {
@@ -12,59 +58,44 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
   if (stresses.empty())
     return redundant;
 
-  // The basis by equation: which stresses each connection equation takes part in.
-  std::vector<std::vector<std::pair<int, double>>> stressesOfRow(model.numConstraints());
-  for (int s = 0; s < static_cast<int>(stresses.size()); ++s) {
-    for (const auto& [row, value] : stresses[s]) {
-      if (model.equations[row].source == EquationSource::Joint)
-        stressesOfRow[row].emplace_back(s, value);
-    }
-  }
-  std::vector<std::vector<int>> rowsOfLink(numLinks);
-  for (int r = 0; r < model.numConstraints(); ++r) {
-    const ConstraintEquation& eq = model.equations[r];
-    if (eq.source != EquationSource::Joint)
-      continue;
-    const Joint& joint = mechanism.joints[eq.element];
-    rowsOfLink[joint.link1].push_back(r);
-    if (joint.link2 != joint.link1)
-      rowsOfLink[joint.link2].push_back(r);
-  }
-
-  std::vector<int> columnOf(stresses.size(), -1), columns;
+  const SparseJacobian Y = stressesByJointRow(model, stresses);
+  const core_detail::Buckets rowsOfLink = connectionRowsOfLinks(mechanism, model);
+  auto stressesAt = [&](int r) { return Y.outerIndexPtr()[r + 1] - Y.outerIndexPtr()[r]; };
+  // Reused from link to link.
+  std::vector<int> columnOf(stresses.size(), -1), columns, rows;
+  SparseJacobian Yl;
+  std::vector<std::pair<int, double>> scratch;
   for (int l = 0; l < numLinks; ++l) {
-    const int k = static_cast<int>(rowsOfLink[l].size());
+    const core_detail::BucketRange linkRows = rowsOfLink[l];
+    const int k = static_cast<int>(linkRows.size());
     if (l == mechanism.rootLink || k <= model.lambda)
       continue;
     columns.clear();
-    for (int r : rowsOfLink[l]) {
-      for (const auto& entry : stressesOfRow[r]) {
-        if (columnOf[entry.first] < 0) {
-          columnOf[entry.first] = static_cast<int>(columns.size());
-          columns.push_back(entry.first);
+    for (int r : linkRows) {
+      for (SparseJacobian::InnerIterator it(Y, r); it; ++it) {
+        if (columnOf[it.col()] < 0) {
+          columnOf[it.col()] = static_cast<int>(columns.size());
+          columns.push_back(static_cast<int>(it.col()));
         }
       }
     }
     const int needed = k - model.lambda;
-    if (static_cast<int>(columns.size()) >= needed) {
+    const int numColumns = static_cast<int>(columns.size());
+    if (numColumns >= needed) {
       // rank(Y_l) by the sparse elimination, its rows (each scaled to unit norm, which leaves the rank alone)
       // taken sparsest first: a connection that every stress of the link shares (the first hinge of a door)
-      // comes last and is reduced by the few-entry rows, instead of filling each of them.
-      std::vector<Eigen::Triplet<double>> triplets;
-      for (int i = 0; i < k; ++i) {
-        for (const auto& [stress, value] : stressesOfRow[rowsOfLink[l][i]]) {
-          triplets.emplace_back(i, columnOf[stress], value);
-        }
+      // comes last and is reduced by the few-entry rows, instead of filling each of them. Once every column
+      // holds a pivot the remaining rows are dependent.
+      rows.assign(linkRows.begin(), linkRows.end());
+      std::stable_sort(rows.begin(), rows.end(), [&](int a, int b) { return stressesAt(a) < stressesAt(b); });
+      core_detail::copyRows(
+          Y, rows, [&](int column) { return columnOf[column]; }, numColumns, Yl, scratch);
+      SparseElimination elimination(numColumns, {}, tolerance, false);
+      for (int i = 0; i < k && elimination.rank() < numColumns; ++i) {
+        const double norm = Yl.row(i).norm();
+        elimination.addRow(Yl, i, norm > 0.0 ? 1.0 / norm : 0.0);
       }
-      SparseJacobian Yl(k, static_cast<int>(columns.size()));
-      Yl.setFromTriplets(triplets.begin(), triplets.end());
-      EliminationOptions options;
-      options.rowOrder.resize(k);
-      std::iota(options.rowOrder.begin(), options.rowOrder.end(), 0);
-      std::stable_sort(options.rowOrder.begin(), options.rowOrder.end(),
-                       [&](int a, int b) { return Yl.row(a).nonZeros() < Yl.row(b).nonZeros(); });
-      options.stopAtFullRank = true;
-      redundant[l] = computeSparseElimination(Yl, tolerance, options).rank == needed;
+      redundant[l] = elimination.rank() == needed;
     }
     for (int s : columns)
       columnOf[s] = -1;
