@@ -10,6 +10,7 @@
 #include "mobility_analysis/RedundantLinks.hpp"
 #include "mobility_analysis/SelfStressBasis.hpp"
 #include "mobility_analysis/Tolerances.hpp"
+#include "mobility_analysis/analysis/CompositeBalls.hpp"
 #include "mobility_analysis/analysis/FiniteMobility.hpp"
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
 #include "mobility_analysis/analysis/SelfStressReport.hpp"
@@ -34,9 +35,10 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
 }  // namespace
 
 Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const AnalysisOptions& options) {
-  const bool hasActive = std::any_of(mechanism.joints.begin(), mechanism.joints.end(), [](const Joint& joint) {
-    return joint.kind == ConnectionKind::Cable && joint.cableType == CableType::Active;
-  });
+  const bool hasActive =
+      std::any_of(mechanism.joints.begin(), mechanism.joints.end(), [](const Joint& joint) {
+        return joint.kind == ConnectionKind::Cable && joint.cableType == CableType::Active;
+      });
   if (!options.lockActiveCables || !hasActive)
     return analyzeAssembled(mechanism, options, {});
   // Lock at the pose the free mechanism assembles to, then analyse the locked copy from there.
@@ -53,6 +55,32 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
 }
 
 namespace {
+
+/**
+ * Idle groups' motions (Tsai): a rod spinning between two balls, a link sliding between parallel slides.
+ * Where balls are written as three revolutes (Gepetto's way, analysis/CompositeBalls.hpp) the search runs on
+ * the mechanism with those balls as spherical joints, at the same pose: the two links inside a ball turn with
+ * the rod it carries, so in the mechanism as written no group moves while the rest stays put.
+ */
+PassiveFreedoms findIdleMotions(const Mechanism& mechanism, const AssembledMechanism& assembled,
+                                const SparseJacobian& J) {
+  const CoordinateModel& model = assembled.model;
+  if (model.mode == AnalysisMode::Spatial) {
+    const std::vector<CompositeBall> balls =
+        findCompositeBalls(mechanism, assembled.poses, model.characteristicLength);
+    if (!balls.empty()) {
+      const MechanismWithBalls merged = mergeCompositeBalls(mechanism, assembled.poses, balls);
+      const Result<CoordinateModel> built = buildCoordinateModel(
+          merged.mechanism, merged.poses, AnalysisMode::Spatial, model.characteristicLength);
+      if (isOk(built)) {
+        const CoordinateModel& withBalls = valueOf(built);
+        const Eigen::VectorXd q = computeCoordinates(withBalls, merged.poses);
+        return findPassiveFreedoms(merged.mechanism, withBalls, q, computeConstraintJacobian(withBalls, q));
+      }
+    }
+  }
+  return findPassiveFreedoms(mechanism, model, assembled.q, J);
+}
 
 Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const AnalysisOptions& options,
                                           const std::vector<bool>& lockedCables) {
@@ -107,8 +135,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   report.finiteDof = finite.finiteDof;
   report.singular = finite.singular;
   progress("passive freedoms", 0.87);
-  // Idle groups' motions (Tsai): a rod spinning between two balls, a link sliding between parallel slides.
-  const PassiveFreedoms passive = findPassiveFreedoms(mechanism, model, analysis.assembled.q, J);
+  const PassiveFreedoms passive = findIdleMotions(mechanism, analysis.assembled, J);
   report.passiveDof = std::min(passive.dof, report.finiteDof);
   report.passiveMotions = passive.motions;
   report.outputDof = report.finiteDof - report.passiveDof;
@@ -163,8 +190,8 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
     const bool coupling =
         eq.source == EquationSource::Joint && mechanism.joints[eq.element].kind == ConnectionKind::Coupling;
     report.redundantConstraints.push_back(RedundantConstraint{r, coupling ? "coupling" : toString(eq.source),
-                                                              elementName(eq),
-                                                              toString(eq.kind), describeEquation(model, r)});
+                                                              elementName(eq), toString(eq.kind),
+                                                              describeEquation(model, r)});
     // Only the design makes joints and ground constraints redundant, not a pose.
     if (finite.configurationCause[r]) {
       report.redundantConstraints.back().cause = "configuration";
@@ -223,9 +250,9 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
                                 : joint.cableType == CableType::Active ? "driving"
                                 : model.jointActive[j]                 ? "taut"
                                                                        : "slack";
-      report.cables.push_back(CableState{
-          joint.name, locked || joint.cableType == CableType::Active ? "active" : "passive", state, joint.length,
-          distance});
+      report.cables.push_back(
+          CableState{joint.name, locked || joint.cableType == CableType::Active ? "active" : "passive", state,
+                     joint.length, distance});
     }
   }
   progress("self-stress report", 0.95);

@@ -15,16 +15,16 @@ namespace mobility_analysis {
  * @brief Passive (idle) freedoms, after Tsai (1999, "Robot Analysis", §1.4): a motion of an idle group while
  * every link outside the group stays put.
  *
- * An idle group is one link, or a chain of up to three links, joined to the rest of the mechanism by exactly
- * two end connections (each link of a chain has two connections) that reach two other links (a door turning
- * on hinges to the ground alone, or a robot's last link, is output, not idle), that moves as one rigid body;
- * its motion is passive when it is a finite motion (a turn about a line, a slide along a line, or a screw
- * about one) that keeps every constraint while all other links are fixed: an S–S rod or S–P–S leg turning
- * about the line through its ball joints, a link between two coaxial revolutes turning about their axis, the
- * RPPR's middle link sliding along the line of its two parallel prismatic joints. passive_dof is the
- * dimension of the span of all such motions (each a first-order motion of the whole mechanism that is also
- * finite), so output_dof = finite_dof − passive_dof counts the freedoms that move something outside an idle
- * group.
+ * An idle group is one link, or a chain of up to three rigid bodies (links welded by fixed connections count
+ * as one), joined to the rest of the mechanism by exactly two end connections (each link of a chain has two
+ * connections) that reach two other links (a door turning on hinges to the ground alone, or a robot's last
+ * link, is output, not idle), that moves as one rigid body; its motion is passive when it is a finite motion
+ * (a turn about a line, a slide along a line, or a screw about one) that keeps every constraint while all
+ * other links are fixed: an S–S rod or S–P–S leg turning about the line through its ball joints, a link
+ * between two coaxial revolutes turning about their axis, the RPPR's middle link sliding along the line of
+ * its two parallel prismatic joints. passive_dof is the dimension of the span of all such motions (each a
+ * first-order motion of the whole mechanism that is also finite), so output_dof = finite_dof − passive_dof
+ * counts the freedoms that move something outside an idle group.
  */
 struct PassiveFreedoms {
   int dof = 0;

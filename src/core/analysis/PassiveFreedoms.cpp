@@ -23,8 +23,11 @@ constexpr double kTwistNullity = 1e-8;
 constexpr double kFiniteStep = 0.05;
 /// ... and accepts the motion when no constraint moves more than this [normalised length].
 constexpr double kFiniteResidual = 1e-9;
-/// Longest chain of links an idle group may be.
+/// Most rigid bodies an idle group may be: links joined by welds (fixed connections) count as one, so a rod
+/// written as two halves, each with its closure frame, welded at the middle (Gepetto's cut rods) is one.
 constexpr size_t kMaxGroup = 3;
+/// Most links an idle group may hold, welded ones included.
+constexpr size_t kMaxGroupLinks = 2 * kMaxGroup;
 
 /// The finite rigid motion exp(xi) of a twist (omega, v) (Murray, Li & Sastry, eq. 2.36).
 Eigen::Isometry3d exponential(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) {
@@ -339,7 +342,7 @@ bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
 
 /// A candidate group's links, sorted and padded with -1, so that the groups sort (and are taken) as sorted
 /// vectors would.
-using Group = std::array<int, kMaxGroup>;
+using Group = std::array<int, kMaxGroupLinks>;
 
 struct CandidateGroups {
   std::vector<Group> groups;  ///< Sorted, each once.
@@ -357,7 +360,7 @@ void addGroup(const std::vector<int>& path, const EndConnectionBound* bound, Can
   }
   Group group;
   group.fill(-1);
-  for (size_t i = 0; i < path.size(); ++i) {  // insertion sort of at most kMaxGroup links
+  for (size_t i = 0; i < path.size(); ++i) {  // insertion sort of at most kMaxGroupLinks links
     size_t k = i;
     for (; k > 0 && group[k - 1] > path[i]; --k)
       group[k] = group[k - 1];
@@ -366,22 +369,25 @@ void addGroup(const std::vector<int>& path, const EndConnectionBound* bound, Can
   candidates.groups.push_back(group);
 }
 
-/// Adds every chain that continues @p path by links with two connections, up to kMaxGroup links.
-void extendChain(const SearchContext& context, std::vector<int>& path, const EndConnectionBound* bound,
-                 CandidateGroups& candidates) {
-  if (path.size() >= kMaxGroup)
+/// Adds every chain that continues @p path (of @p bodies rigid bodies) by links with two connections, up to
+/// kMaxGroup bodies.
+void extendChain(const SearchContext& context, std::vector<int>& path, size_t bodies,
+                 const EndConnectionBound* bound, CandidateGroups& candidates) {
+  if (path.size() >= kMaxGroupLinks)
     return;
   const int last = path.back();
   if (context.connectionsAt(last).size() != 2)
     return;
   for (int j : context.connectionsAt(last)) {
     const int next = context.otherLink(j, last);
-    if (next == context.mechanism.rootLink || context.connectionsAt(next).size() != 2 ||
+    const size_t more =
+        bodies + (context.mechanism.joints[static_cast<size_t>(j)].type == JointType::Fixed ? 0 : 1);
+    if (more > kMaxGroup || next == context.mechanism.rootLink || context.connectionsAt(next).size() != 2 ||
         std::find(path.begin(), path.end(), next) != path.end())
       continue;
     path.push_back(next);
     addGroup(path, bound, candidates);
-    extendChain(context, path, bound, candidates);
+    extendChain(context, path, more, bound, candidates);
     path.pop_back();
   }
 }
@@ -396,7 +402,7 @@ CandidateGroups findCandidateGroups(const SearchContext& context, const EndConne
       continue;
     chain.assign(1, l);
     addGroup(chain, bound, candidates);
-    extendChain(context, chain, bound, candidates);
+    extendChain(context, chain, 1, bound, candidates);
   }
   std::vector<Group>& groups = candidates.groups;
   std::sort(groups.begin(), groups.end());
