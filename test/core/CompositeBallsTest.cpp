@@ -152,3 +152,25 @@ TEST(CompositeBalls, TheMergedMechanismMovesAsTheWrittenOne) {
       computeOrderedRank(computeConstraintJacobian(valueOf(model), q), tolerances::kRank);
   EXPECT_EQ(ranks.dof(), 9);
 }
+
+TEST(CompositeBalls, SameSplitInMillimetresAndTurnedInSpace) {
+  // The axes must meet within a fraction of Lc, so the test scales with the model: the Gepetto Delta in
+  // millimetres, turned 0.7 rad about (1, 2, 3) (every joint from the ground turned, the rest follows).
+  Mechanism delta = gepetto("delta_gepetto.urdf", "delta_3d.yaml");
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (Joint& joint : delta.joints) {
+    joint.frame1.translation() *= 1000.0;
+    joint.frame2.translation() *= 1000.0;
+    if (joint.link1 == delta.rootLink) {
+      joint.frame1.translation() = turn * joint.frame1.translation();
+      joint.frame1.linear() = turn * joint.frame1.linear();
+    }
+  }
+  const MobilityReport report = spatialReport(delta);
+  EXPECT_LT(report.characteristicLength, 1e3);
+  EXPECT_GT(report.characteristicLength, 1e2);
+  EXPECT_EQ(report.dof, 9);
+  EXPECT_EQ(report.passiveDof, 6);
+  EXPECT_EQ(report.outputDof, 3);
+}
