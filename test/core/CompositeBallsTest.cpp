@@ -174,3 +174,24 @@ TEST(CompositeBalls, SameSplitInMillimetresAndTurnedInSpace) {
   EXPECT_EQ(report.passiveDof, 6);
   EXPECT_EQ(report.outputDof, 3);
 }
+
+TEST(CompositeBalls, MjcfHingeTripleInOneBodyIsABall) {
+  // MuJoCo composes a body's joints in series at their positions: three hinges at one point, then a connect
+  // at the rod's other end to a body welded to the world. The rod spins about the line through both.
+  const char* mjcf = R"(<mujoco model="hinge_triple"><worldbody>
+    <body name="base"><body name="rod" pos="0.2 0.1 0.3">
+      <joint name="hx" type="hinge" axis="1 0 0"/><joint name="hy" type="hinge" axis="0 1 0"/>
+      <joint name="hz" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0 0 -1" size="0.01"/>
+    </body></body>
+    <body name="anchor" pos="0.5 0.1 -0.7"><geom type="sphere" size="0.02"/></body>
+  </worldbody><equality><connect name="bottom" body1="rod" body2="anchor" anchor="0 0 -1"/></equality></mujoco>)";
+  const Result<Mechanism> mechanism = readMechanismFromString(mjcf, "hinge_triple.xml");
+  ASSERT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+  EXPECT_EQ(ballsAtWrittenPose(valueOf(mechanism)).size(), 1u);
+  const MobilityReport report = spatialReport(valueOf(mechanism));
+  EXPECT_EQ(report.dof, 1);
+  EXPECT_EQ(report.passiveDof, 1);
+  ASSERT_EQ(report.passiveMotions.size(), 1u);
+  EXPECT_EQ(report.passiveMotions[0].description,
+            "link rod spins about the line through its ball joints hx+hy+hz and bottom");
+}
