@@ -191,6 +191,9 @@ class EndConnectionBound {
   bool rigidByEnds(const std::vector<int>& path) const;
 
  private:
+  /// rigidByEnds for lambda = @p L: the Gram sums unrolled (3 10^5 groups on a chain of 10^5).
+  template <int L>
+  bool rigidByEndsOf(const std::vector<int>& path) const;
   static constexpr size_t kLinksPerRow = 4;
   /// Per coordinate, the element and the link that own it.
   struct ColumnOwners {
@@ -206,6 +209,9 @@ class EndConnectionBound {
   ColumnOwners findColumnOwners() const;
   void splitRow(Eigen::Index r, const ColumnOwners& owners, RowParts& parts);
   void addRow(Eigen::Index r, const RowParts& parts);
+  /// addRow for lambda = @p L (the Gram updates unrolled).
+  template <int L>
+  void addRowOf(Eigen::Index r, const RowParts& parts);
   /// Which of @p link's two connections @p joint is (0 or 1), or -1.
   int slotOf(int link, int joint) const;
 
@@ -269,7 +275,15 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
 }
 
 void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
-  const int lambda = context_.lambda;
+  if (context_.planar)
+    addRowOf<3>(r, parts);
+  else
+    addRowOf<6>(r, parts);
+}
+
+template <int L>
+void EndConnectionBound::addRowOf(Eigen::Index r, const RowParts& parts) {
+  constexpr int lambda = L;
   const int connection = context_.jointOfRow[static_cast<size_t>(r)];
   const std::pair<int, int>* joint =
       connection >= 0 ? &context_.jointEnds[static_cast<size_t>(connection)] : nullptr;
@@ -309,7 +323,12 @@ int EndConnectionBound::slotOf(int link, int joint) const {
 }
 
 bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
-  const int lambda = context_.lambda;
+  return context_.planar ? rigidByEndsOf<3>(path) : rigidByEndsOf<6>(path);
+}
+
+template <int L>
+bool EndConnectionBound::rigidByEndsOf(const std::vector<int>& path) const {
+  constexpr int lambda = L;
   Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
   double frobenius2 = 0.0;
   int ends = 0;
@@ -334,7 +353,7 @@ bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
   if (ends != 2 || !std::isfinite(frobenius2))
     return false;
   const double limit = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
-  return context_.planar ? clearlyFullRank<3>(gram, limit) : clearlyFullRank<6>(gram, limit);
+  return clearlyFullRank<L>(gram, limit);
 }
 
 /// A candidate group's links, sorted and padded with -1, so that the groups sort (and are taken) as sorted
