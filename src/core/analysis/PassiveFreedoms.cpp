@@ -44,18 +44,52 @@ Eigen::Isometry3d exponential(const Eigen::Vector3d& omega, const Eigen::Vector3
 /// One row of T: the velocity of one coordinate per twist component (lambda of the 6 used, the rest zero).
 using TwistRow = Eigen::Matrix<double, 1, 6>;
 
+/**
+ * @brief The Cholesky factor of the symmetric @p m (lower triangle read) in its lower triangle, in place;
+ *        false where Eigen::LLT reports a non-positive pivot.
+ *
+ * The operations and their order of Eigen's unblocked LLT (llt_inplace::unblocked: a pivot less the squares
+ * of its row, the column below less the products with the rows above, divided by the pivot), so the factor
+ * is Eigen's bit for bit; without its dynamic-size blocks and matrix-vector kernel, a third of the bound's
+ * time on a chain (3 10^5 factorisations of 3 x 3 or 6 x 6).
+ */
+template <int L>
+bool choleskyLower(Eigen::Matrix<double, L, L>& m) {
+  for (int k = 0; k < L; ++k) {
+    double x = m(k, k);
+    if (k > 0) {
+      double squares = m(k, 0) * m(k, 0);
+      for (int j = 1; j < k; ++j)
+        squares += m(k, j) * m(k, j);
+      x -= squares;
+    }
+    if (x <= 0.0)
+      return false;
+    m(k, k) = x = std::sqrt(x);
+    for (int i = k + 1; i < L; ++i) {
+      if (k > 0) {
+        double sum = 0.0;
+        for (int j = 0; j < k; ++j)
+          sum += m(i, j) * m(k, j);
+        m(i, k) += -1.0 * sum;  // as Eigen's kernel adds alpha = -1 times the product
+      }
+      m(i, k) /= x;
+    }
+  }
+  return true;
+}
+
 /// @return Whether sigma_min(A) > @p bound is certain from G = A^T A (its top-left L x L block):
 /// sigma_min(A)^2
 ///         is at least 1 / |G^-1|_F.
 template <int L>
 bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
-  const Eigen::Matrix<double, L, L> g = gram.template topLeftCorner<L, L>();
-  const Eigen::LLT<Eigen::Matrix<double, L, L>> llt(g);
-  if (llt.info() != Eigen::Success)
+  Eigen::Matrix<double, L, L> factor = gram.template topLeftCorner<L, L>();
+  if (!choleskyLower<L>(factor))
     return false;
   // G^-1 = L^-T L^-1, with L^-1 by forward substitution in fixed-size storage: llt.solve(Identity) went
   // through Eigen's general blocked triangular solver, half the search's time on a chain (3 10^5 calls).
-  const Eigen::Matrix<double, L, L> lower = llt.matrixLLT().template triangularView<Eigen::Lower>();
+  const Eigen::Matrix<double, L, L> lower = factor.template triangularView<Eigen::Lower>();
   Eigen::Matrix<double, L, L> inverseLower = Eigen::Matrix<double, L, L>::Zero();
   for (int c = 0; c < L; ++c) {
     inverseLower(c, c) = 1.0 / lower(c, c);
