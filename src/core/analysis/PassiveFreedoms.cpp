@@ -79,12 +79,11 @@ bool choleskyLower(Eigen::Matrix<double, L, L>& m) {
   return true;
 }
 
-/// @return Whether sigma_min(A) > @p bound is certain from G = A^T A (its top-left L x L block):
-/// sigma_min(A)^2
-///         is at least 1 / |G^-1|_F.
+/// @return Whether sigma_min(A) > @p bound is certain from G = A^T A (L x L): sigma_min(A)^2 is at least
+/// 1 / |G^-1|_F.
 template <int L>
-bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
-  Eigen::Matrix<double, L, L> factor = gram.template topLeftCorner<L, L>();
+bool clearlyFullRank(const Eigen::Matrix<double, L, L>& gram, double bound) {
+  Eigen::Matrix<double, L, L> factor = gram;
   if (!choleskyLower<L>(factor))
     return false;
   // G^-1 = L^-T L^-1, with L^-1 by forward substitution in fixed-size storage: llt.solve(Identity) went
@@ -363,14 +362,20 @@ bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
 template <int L>
 bool EndConnectionBound::rigidByEndsOf(const std::vector<int>& path) const {
   constexpr int lambda = L;
-  Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, L, L> gram = Eigen::Matrix<double, L, L>::Zero();
   double frobenius2 = 0.0;
   int ends = 0;
+  auto inPath = [&path](int link) {  // at most kMaxGroup links
+    for (const int l : path) {
+      if (l == link)
+        return true;
+    }
+    return false;
+  };
   for (int l : path) {
     frobenius2 += linkFrobenius_[static_cast<size_t>(l)];
     for (size_t s = 0; s < 2; ++s) {
-      const int other = context_.otherLink(context_.connectionsAt(l)[s], l);
-      if (std::find(path.begin(), path.end(), other) != path.end())
+      if (inPath(context_.otherLink(context_.connectionsAt(l)[s], l)))
         continue;
       const size_t at = static_cast<size_t>(l) * 2 + s;
       if (!endValid_[at])
@@ -606,7 +611,8 @@ bool GroupSearch::boundsClearNullity() const {
     frobenius2 += a.squaredNorm();
   }
   const double bound = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
-  return context_.planar ? clearlyFullRank<3>(gram, bound) : clearlyFullRank<6>(gram, bound);
+  return context_.planar ? clearlyFullRank<3>(gram.topLeftCorner<3, 3>().eval(), bound)
+                          : clearlyFullRank<6>(gram, bound);
 }
 
 Eigen::MatrixXd GroupSearch::buildT() const {
