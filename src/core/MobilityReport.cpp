@@ -70,14 +70,24 @@ class BufferedAppender {
   size_t used_ = 0;
 };
 
+/// Per byte: whether it goes into a JSON string as it is (printable ASCII but '"' and '\\').
+struct PlainBytes {
+  bool plain[256] = {};
+  constexpr PlainBytes() {
+    for (int c = 0x20; c < 0x80; ++c)
+      plain[c] = c != '"' && c != '\\';
+  }
+};
+constexpr PlainBytes kPlainBytes;
+
 template <class Out>
 void appendQuoted(Out& out, const std::string& text) {
   out += '"';
   for (size_t i = 0; i < text.size(); ++i) {
-    // A run of characters that need no escape goes in at once (most names are all of one run).
+    // A run of characters that need no escape goes in at once (most names are all of one run); one table
+    // look-up a byte.
     size_t plain = i;
-    while (plain < text.size() && static_cast<unsigned char>(text[plain]) >= 0x20 &&
-           static_cast<unsigned char>(text[plain]) < 0x80 && text[plain] != '"' && text[plain] != '\\')
+    while (plain < text.size() && kPlainBytes.plain[static_cast<unsigned char>(text[plain])])
       ++plain;
     if (plain > i) {
       out.append(text, i, plain - i);
