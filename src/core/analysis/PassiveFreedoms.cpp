@@ -175,9 +175,14 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
     connections_.add(jointEnds[j].first, static_cast<int>(j));
     connections_.add(jointEnds[j].second, static_cast<int>(j));
   }
-  // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
-  for (Eigen::Index r = 0; r < J.rows(); ++r)
-    rowNorm[static_cast<size_t>(r)] = J.row(r).norm();
+  // Each row's norm once (a row is in up to 3 kMaxGroup groups): the squares summed in the row's order from
+  // 0, as J.row(r).norm() sums them, without its generic sparse iterators.
+  for (Eigen::Index r = 0; r < J.rows(); ++r) {
+    double squares = 0.0;
+    for (SparseJacobian::InnerIterator it(J, r); it; ++it)
+      squares += it.value() * it.value();
+    rowNorm[static_cast<size_t>(r)] = std::sqrt(squares);
+  }
 }
 
 Eigen::Vector3d SearchContext::element3(int e) const {
