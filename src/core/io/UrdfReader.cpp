@@ -257,7 +257,8 @@ class Reader {
       if (*at == '\0')
         break;
       const char* tokenEnd = at;
-      while (*tokenEnd != '\0' && !isBlank(*tokenEnd))
+      // Characters above ' ' are neither blank nor the end: one comparison for each of a number's digits.
+      while (static_cast<unsigned char>(*tokenEnd) > ' ' || (*tokenEnd != '\0' && !isBlank(*tokenEnd)))
         ++tokenEnd;
       if (count == 3)
         fail(kind, name, attribute.str() + " has more than 3 numbers: '" + text + "'");
