@@ -421,7 +421,9 @@ class Reader {
              "type '" + std::string(type == nullptr ? "" : type) +
                  "' is not a URDF tree type (revolute, continuous, prismatic, fixed, floating, planar)");
       }
-      Joint joint;
+      // Written in place at the end of the connections (reserved: no reallocation), not built apart and moved
+      // in: a Joint is 400 bytes. A refusal below abandons the whole mechanism, this joint with it.
+      Joint& joint = mechanism_.joints.emplace_back();
       joint.kind = ConnectionKind::TreeJoint;
       joint.type = *jointType;
       joint.link1 = parentLink;
@@ -457,7 +459,7 @@ class Reader {
       }
       parentOf_[childLink] = parentLink;
       joint.name = std::move(name);
-      addConnection(std::move(joint));
+      connectionIndex_.insert(joint.name, static_cast<int>(mechanism_.joints.size()) - 1);
     }
   }
 
