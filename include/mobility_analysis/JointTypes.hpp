@@ -66,7 +66,7 @@ struct JointTypeSpec {
 const JointTypeSpec& getJointTypeSpec(JointType type);
 
 /// @return The equation groups of a planar form (Free and Invalid: none).
-std::vector<Primitive> planarPrimitives(PlanarForm form);
+const std::vector<Primitive>& planarPrimitives(PlanarForm form);
 
 /// @return The planar freedom F_i (lambda = 3) of @p form.
 int planarFreedom(PlanarForm form);

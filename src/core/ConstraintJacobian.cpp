@@ -1,5 +1,6 @@
 #include "mobility_analysis/ConstraintJacobian.hpp"
 
+#include <algorithm>
 #include <vector>
 
 #include "mobility_analysis/coordinates/EquationForms.hpp"
@@ -18,19 +19,70 @@ void computeConstraintResidual(const CoordinateModel& model, const Eigen::Ref<co
   }
 }
 
+namespace {
+
+/// The rows of a sparse matrix written one after another: column indices and values, and where each row starts.
+struct RowsWritten {
+  std::vector<int> columns;
+  std::vector<double> values;
+  std::vector<int> rowStart{0};
+};
+
+/**
+ * @brief Appends one equation's gradient, as its form wrote it, as the next row of @p rows: the entries
+ *        ordered by column (stable), repeated columns summed in the order written, exact zeros dropped.
+ *
+ * The same row, value for value, as setFromTriplets followed by prune(0.0) gave (it sums a column's entries
+ * in triplet order and stores a row's columns in order), without the matrix of all triplets and the
+ * column-major copy it was transposed from.
+ */
+void appendRow(GradientSink& entries, RowsWritten& rows) {
+  for (size_t i = 1; i < entries.size(); ++i) {  // insertion sort: a row has a dozen entries at most
+    const Eigen::Triplet<double> entry = entries[i];
+    size_t k = i;
+    for (; k > 0 && entries[k - 1].col() > entry.col(); --k)
+      entries[k] = entries[k - 1];
+    entries[k] = entry;
+  }
+  for (size_t i = 0; i < entries.size();) {
+    const int column = entries[i].col();
+    double value = entries[i].value();
+    for (++i; i < entries.size() && entries[i].col() == column; ++i)
+      value += entries[i].value();
+    if (value != 0.0) {
+      rows.columns.push_back(column);
+      rows.values.push_back(value);
+    }
+  }
+  rows.rowStart.push_back(static_cast<int>(rows.columns.size()));
+}
+
+/// @p rows as a compressed row-major matrix with @p numColumns columns, its storage of the exact size.
+SparseJacobian toMatrix(const RowsWritten& rows, int numColumns) {
+  SparseJacobian matrix(static_cast<Eigen::Index>(rows.rowStart.size()) - 1, numColumns);
+  matrix.resizeNonZeros(static_cast<Eigen::Index>(rows.columns.size()));
+  std::copy(rows.rowStart.begin(), rows.rowStart.end(), matrix.outerIndexPtr());
+  std::copy(rows.columns.begin(), rows.columns.end(), matrix.innerIndexPtr());
+  std::copy(rows.values.begin(), rows.values.end(), matrix.valuePtr());
+  return matrix;
+}
+
+}  // namespace
+
 SparseJacobian computeConstraintJacobian(const CoordinateModel& model,
                                          const Eigen::Ref<const Eigen::VectorXd>& q) {
   const ElementView view(model, q);
-  GradientSink triplets;
-  triplets.reserve(static_cast<size_t>(model.numConstraints()) * 12);
+  // The rows are written in order, each from its own equation's few entries.
+  RowsWritten rows;
+  rows.rowStart.reserve(static_cast<size_t>(model.numConstraints()) + 1);
+  GradientSink entries;
   for (int i = 0; i < model.numConstraints(); ++i) {
     const ConstraintEquation& eq = model.equations[i];
-    visitForm(eq.form, [&](auto form) { form.gradient(view, eq, i, triplets); });
+    entries.clear();
+    visitForm(eq.form, [&](auto form) { form.gradient(view, eq, i, entries); });
+    appendRow(entries, rows);
   }
-  SparseJacobian jacobian(model.numConstraints(), model.numCoordinates());
-  jacobian.setFromTriplets(triplets.begin(), triplets.end());
-  jacobian.prune(0.0);
-  return jacobian;
+  return toMatrix(rows, model.numCoordinates());
 }
 
 Eigen::MatrixXd computeEquationHessian(const CoordinateModel& model,

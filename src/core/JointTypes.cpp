@@ -73,15 +73,20 @@ const JointTypeSpec& getJointTypeSpec(JointType type) {
   return kJointTypes[0];  // unreachable: every enumerator has a row
 }
 
-std::vector<Primitive> planarPrimitives(PlanarForm form) {
+const std::vector<Primitive>& planarPrimitives(PlanarForm form) {
+  // Static, as the spatial rows of kJointTypes: a copy per connection would be an allocation each.
+  static const std::vector<Primitive> kPin = {Primitive::CoincidentPoint};
+  static const std::vector<Primitive> kSlider = {Primitive::ParallelAxis, Primitive::PointOnAxisLine};
+  static const std::vector<Primitive> kWeld = {Primitive::CoincidentPoint, Primitive::FixedTwist};
+  static const std::vector<Primitive> kNone;
   switch (form) {
-    case PlanarForm::Pin: return {Primitive::CoincidentPoint};
-    case PlanarForm::Slider: return {Primitive::ParallelAxis, Primitive::PointOnAxisLine};
-    case PlanarForm::Weld: return {Primitive::CoincidentPoint, Primitive::FixedTwist};
+    case PlanarForm::Pin: return kPin;
+    case PlanarForm::Slider: return kSlider;
+    case PlanarForm::Weld: return kWeld;
     case PlanarForm::Free:
-    case PlanarForm::Invalid: return {};
+    case PlanarForm::Invalid: return kNone;
   }
-  return {};
+  return kNone;
 }
 
 int planarFreedom(PlanarForm form) {

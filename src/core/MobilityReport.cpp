@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 
 namespace mobility_analysis {
@@ -18,13 +19,75 @@ const char* toString(ElementClass elementClass) {
 
 namespace {
 
-void appendQuoted(std::string& out, const std::string& text) {
+/**
+ * @brief Appends to a string through a fixed buffer: one std::string::append per few kilobytes instead of one
+ *        per piece (the links, joints and positions of a chain of 10^5 links are 3 10^5 records of about ten
+ *        pieces each, and each append is a call with its own capacity check). Flushed when destroyed.
+ */
+class BufferedAppender {
+ public:
+  explicit BufferedAppender(std::string& out) : out_(out) {}
+  BufferedAppender(const BufferedAppender&) = delete;
+  BufferedAppender& operator=(const BufferedAppender&) = delete;
+  ~BufferedAppender() { flush(); }
+
+  void append(const char* data, size_t size) {
+    if (used_ + size > sizeof(buffer_)) {
+      flush();
+      if (size > sizeof(buffer_)) {
+        out_.append(data, size);
+        return;
+      }
+    }
+    std::memcpy(buffer_ + used_, data, size);
+    used_ += size;
+  }
+  void append(const char* first, const char* last) { append(first, static_cast<size_t>(last - first)); }
+  void append(const std::string& text, size_t at, size_t size) { append(text.data() + at, size); }
+  BufferedAppender& operator+=(char c) {
+    if (used_ == sizeof(buffer_))
+      flush();
+    buffer_[used_++] = c;
+    return *this;
+  }
+  BufferedAppender& operator+=(const char* text) {
+    append(text, std::strlen(text));
+    return *this;
+  }
+  BufferedAppender& operator+=(const std::string& text) {
+    append(text.data(), text.size());
+    return *this;
+  }
+
+ private:
+  void flush() {
+    out_.append(buffer_, used_);
+    used_ = 0;
+  }
+
+  std::string& out_;
+  char buffer_[4096];
+  size_t used_ = 0;
+};
+
+/// Per byte: whether it goes into a JSON string as it is (printable ASCII but '"' and '\\').
+struct PlainBytes {
+  bool plain[256] = {};
+  constexpr PlainBytes() {
+    for (int c = 0x20; c < 0x80; ++c)
+      plain[c] = c != '"' && c != '\\';
+  }
+};
+constexpr PlainBytes kPlainBytes;
+
+template <class Out>
+void appendQuoted(Out& out, const std::string& text) {
   out += '"';
   for (size_t i = 0; i < text.size(); ++i) {
-    // A run of characters that need no escape goes in at once (most names are all of one run).
+    // A run of characters that need no escape goes in at once (most names are all of one run); one table
+    // look-up a byte.
     size_t plain = i;
-    while (plain < text.size() && static_cast<unsigned char>(text[plain]) >= 0x20 &&
-           static_cast<unsigned char>(text[plain]) < 0x80 && text[plain] != '"' && text[plain] != '\\')
+    while (plain < text.size() && kPlainBytes.plain[static_cast<unsigned char>(text[plain])])
       ++plain;
     if (plain > i) {
       out.append(text, i, plain - i);
@@ -70,7 +133,8 @@ std::string quote(const std::string& text) {
 /// nan: a non-finite number is written as null (writeJson refuses such a report before it gets here).
 /// std::to_chars in the general format with a precision is printf's %.*g in the C locale, several times
 /// faster (a report of a large grid writes millions of forces).
-void appendNumber(std::string& out, double value, int digits = 9) {
+template <class Out>
+void appendNumber(Out& out, double value, int digits = 9) {
   if (!std::isfinite(value)) {
     out += "null";
     return;
@@ -99,7 +163,8 @@ std::string array(const std::vector<T>& items, F&& write) {
 }
 
 /// {"name": …, "kind": …, "force": …}, appended (the states of a large grid hold millions of these).
-void appendForce(std::string& out, const ElementForce& f) {
+template <class Out>
+void appendForce(Out& out, const ElementForce& f) {
   out += "{\"name\": ";
   appendQuoted(out, f.name);
   out += ", \"kind\": ";
@@ -109,7 +174,8 @@ void appendForce(std::string& out, const ElementForce& f) {
   out += '}';
 }
 
-void appendForces(std::string& out, const std::vector<ElementForce>& forces) {
+template <class Out>
+void appendForces(Out& out, const std::vector<ElementForce>& forces) {
   out += '[';
   for (size_t i = 0; i < forces.size(); ++i) {
     if (i)
@@ -124,7 +190,8 @@ std::string cableJson(const CableState& c) {
          ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) + "}";
 }
 
-void appendSelfStress(std::string& out, const SelfStressInfo& s) {
+template <class Out>
+void appendSelfStress(Out& out, const SelfStressInfo& s) {
   out += "{\"count\": " + std::to_string(s.count) +
          ", \"mechanism_modes\": " + std::to_string(s.mechanismModes) +
          ", \"states_listed\": " + (s.statesListed ? "true" : "false") + ", \"states\": [";
@@ -158,17 +225,28 @@ std::string deploymentJson(const DeploymentInfo& d) {
   return out + "]}";
 }
 
+/// The JSON of @p r appended to @p text.
+void writeJson(const MobilityReport& r, std::string& text);
+
 }  // namespace
 
 std::string toJson(const MobilityReport& r) {
-  // One string, appended to in place: the links, joints and positions of a 10^5-link chain are 3 10^5 small
-  // objects, each once built apart and copied in.
-  std::string out;
-  out.reserve(256 + 96 * (r.links.size() + r.joints.size()) + 48 * r.positions.size() +
-              160 * r.redundantConstraints.size());
+  // One string, appended to in place (through a buffer, BufferedAppender): the links, joints and positions of
+  // a 10^5-link chain are 3 10^5 small objects, each once built apart and copied in.
+  std::string text;
+  text.reserve(256 + 96 * (r.links.size() + r.joints.size()) + 48 * r.positions.size() +
+               160 * r.redundantConstraints.size());
+  writeJson(r, text);
+  return text;
+}
+
+namespace {
+
+void writeJson(const MobilityReport& r, std::string& text) {
+  BufferedAppender out(text);
   auto integer = [&out](long long value) {
-    char text[24];
-    out.append(text, std::to_chars(text, text + sizeof(text), value).ptr);
+    char digits[24];
+    out.append(digits, std::to_chars(digits, digits + sizeof(digits), value).ptr);
   };
   auto boolean = [&out](bool value) { out += value ? "true" : "false"; };
   // "[a, b, …]" with each item appended by @p write.
@@ -348,8 +426,9 @@ std::string toJson(const MobilityReport& r) {
   field("warnings");
   list(r.warnings, quoted);
   out += "\n}\n";
-  return out;
 }
+
+}  // namespace
 
 std::string toText(const MobilityReport& r) {
   std::ostringstream out;

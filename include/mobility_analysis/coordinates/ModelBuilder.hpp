@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -29,8 +31,24 @@ namespace mobility_analysis {
 
 /// Per connection: the elements its equations use on each side (-1 when not needed) and its primitives.
 struct ConnectionElements {
+  /// At most three primitives a connection (JointTypes.cpp), kept in place: a vector each was an allocation
+  /// per connection (10^5 on a chain).
+  class Primitives {
+   public:
+    Primitives& operator=(const std::vector<Primitive>& list) {
+      count_ = std::min(list.size(), items_.size());
+      std::copy(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(count_), items_.begin());
+      return *this;
+    }
+    const Primitive* begin() const { return items_.data(); }
+    const Primitive* end() const { return items_.data() + count_; }
+
+   private:
+    std::array<Primitive, 3> items_{};
+    size_t count_ = 0;
+  };
   int point1 = -1, point2 = -1, axis1 = -1, axis2 = -1;
-  std::vector<Primitive> primitives;
+  Primitives primitives;
   Eigen::Vector3d axisWorld = Eigen::Vector3d::UnitZ();
 };
 

@@ -47,18 +47,51 @@ Eigen::Isometry3d exponential(const Eigen::Vector3d& omega, const Eigen::Vector3
 /// One row of T: the velocity of one coordinate per twist component (lambda of the 6 used, the rest zero).
 using TwistRow = Eigen::Matrix<double, 1, 6>;
 
-/// @return Whether sigma_min(A) > @p bound is certain from G = A^T A (its top-left L x L block):
-/// sigma_min(A)^2
-///         is at least 1 / |G^-1|_F.
+/**
+ * @brief The Cholesky factor of the symmetric @p m (lower triangle read) in its lower triangle, in place;
+ *        false where Eigen::LLT reports a non-positive pivot.
+ *
+ * The operations and their order of Eigen's unblocked LLT (llt_inplace::unblocked: a pivot less the squares
+ * of its row, the column below less the products with the rows above, divided by the pivot), so the factor
+ * is Eigen's bit for bit; without its dynamic-size blocks and matrix-vector kernel, a third of the bound's
+ * time on a chain (3 10^5 factorisations of 3 x 3 or 6 x 6).
+ */
 template <int L>
-bool clearlyFullRank(const Eigen::Matrix<double, 6, 6>& gram, double bound) {
-  const Eigen::Matrix<double, L, L> g = gram.template topLeftCorner<L, L>();
-  const Eigen::LLT<Eigen::Matrix<double, L, L>> llt(g);
-  if (llt.info() != Eigen::Success)
+bool choleskyLower(Eigen::Matrix<double, L, L>& m) {
+  for (int k = 0; k < L; ++k) {
+    double x = m(k, k);
+    if (k > 0) {
+      double squares = m(k, 0) * m(k, 0);
+      for (int j = 1; j < k; ++j)
+        squares += m(k, j) * m(k, j);
+      x -= squares;
+    }
+    if (x <= 0.0)
+      return false;
+    m(k, k) = x = std::sqrt(x);
+    for (int i = k + 1; i < L; ++i) {
+      if (k > 0) {
+        double sum = 0.0;
+        for (int j = 0; j < k; ++j)
+          sum += m(i, j) * m(k, j);
+        m(i, k) += -1.0 * sum;  // as Eigen's kernel adds alpha = -1 times the product
+      }
+      m(i, k) /= x;
+    }
+  }
+  return true;
+}
+
+/// @return Whether sigma_min(A) > @p bound is certain from G = A^T A (L x L): sigma_min(A)^2 is at least
+/// 1 / |G^-1|_F.
+template <int L>
+bool clearlyFullRank(const Eigen::Matrix<double, L, L>& gram, double bound) {
+  Eigen::Matrix<double, L, L> factor = gram;
+  if (!choleskyLower<L>(factor))
     return false;
   // G^-1 = L^-T L^-1, with L^-1 by forward substitution in fixed-size storage: llt.solve(Identity) went
   // through Eigen's general blocked triangular solver, half the search's time on a chain (3 10^5 calls).
-  const Eigen::Matrix<double, L, L> lower = llt.matrixLLT().template triangularView<Eigen::Lower>();
+  const Eigen::Matrix<double, L, L> lower = factor.template triangularView<Eigen::Lower>();
   Eigen::Matrix<double, L, L> inverseLower = Eigen::Matrix<double, L, L>::Zero();
   for (int c = 0; c < L; ++c) {
     inverseLower(c, c) = 1.0 / lower(c, c);
@@ -145,9 +178,14 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
     connections_.add(jointEnds[j].first, static_cast<int>(j));
     connections_.add(jointEnds[j].second, static_cast<int>(j));
   }
-  // Each row's norm once (a row is in up to 3 kMaxGroup groups), by the same expression as before.
-  for (Eigen::Index r = 0; r < J.rows(); ++r)
-    rowNorm[static_cast<size_t>(r)] = J.row(r).norm();
+  // Each row's norm once (a row is in up to 3 kMaxGroup groups): the squares summed in the row's order from
+  // 0, as J.row(r).norm() sums them, without its generic sparse iterators.
+  for (Eigen::Index r = 0; r < J.rows(); ++r) {
+    double squares = 0.0;
+    for (SparseJacobian::InnerIterator it(J, r); it; ++it)
+      squares += it.value() * it.value();
+    rowNorm[static_cast<size_t>(r)] = std::sqrt(squares);
+  }
 }
 
 Eigen::Vector3d SearchContext::element3(int e) const {
@@ -194,6 +232,9 @@ class EndConnectionBound {
   bool rigidByEnds(const std::vector<int>& path) const;
 
  private:
+  /// rigidByEnds for lambda = @p L: the Gram sums unrolled (3 10^5 groups on a chain of 10^5).
+  template <int L>
+  bool rigidByEndsOf(const std::vector<int>& path) const;
   static constexpr size_t kLinksPerRow = 4;
   /// Per coordinate, the element and the link that own it.
   struct ColumnOwners {
@@ -209,6 +250,9 @@ class EndConnectionBound {
   ColumnOwners findColumnOwners() const;
   void splitRow(Eigen::Index r, const ColumnOwners& owners, RowParts& parts);
   void addRow(Eigen::Index r, const RowParts& parts);
+  /// addRow for lambda = @p L (the Gram updates unrolled).
+  template <int L>
+  void addRowOf(Eigen::Index r, const RowParts& parts);
   /// Which of @p link's two connections @p joint is (0 or 1), or -1.
   int slotOf(int link, int joint) const;
 
@@ -272,7 +316,15 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
 }
 
 void EndConnectionBound::addRow(Eigen::Index r, const RowParts& parts) {
-  const int lambda = context_.lambda;
+  if (context_.planar)
+    addRowOf<3>(r, parts);
+  else
+    addRowOf<6>(r, parts);
+}
+
+template <int L>
+void EndConnectionBound::addRowOf(Eigen::Index r, const RowParts& parts) {
+  constexpr int lambda = L;
   const int connection = context_.jointOfRow[static_cast<size_t>(r)];
   const std::pair<int, int>* joint =
       connection >= 0 ? &context_.jointEnds[static_cast<size_t>(connection)] : nullptr;
@@ -312,15 +364,26 @@ int EndConnectionBound::slotOf(int link, int joint) const {
 }
 
 bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
-  const int lambda = context_.lambda;
-  Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+  return context_.planar ? rigidByEndsOf<3>(path) : rigidByEndsOf<6>(path);
+}
+
+template <int L>
+bool EndConnectionBound::rigidByEndsOf(const std::vector<int>& path) const {
+  constexpr int lambda = L;
+  Eigen::Matrix<double, L, L> gram = Eigen::Matrix<double, L, L>::Zero();
   double frobenius2 = 0.0;
   int ends = 0;
+  auto inPath = [&path](int link) {  // at most kMaxGroup links
+    for (const int l : path) {
+      if (l == link)
+        return true;
+    }
+    return false;
+  };
   for (int l : path) {
     frobenius2 += linkFrobenius_[static_cast<size_t>(l)];
     for (size_t s = 0; s < 2; ++s) {
-      const int other = context_.otherLink(context_.connectionsAt(l)[s], l);
-      if (std::find(path.begin(), path.end(), other) != path.end())
+      if (inPath(context_.otherLink(context_.connectionsAt(l)[s], l)))
         continue;
       const size_t at = static_cast<size_t>(l) * 2 + s;
       if (!endValid_[at])
@@ -337,7 +400,7 @@ bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
   if (ends != 2 || !std::isfinite(frobenius2))
     return false;
   const double limit = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
-  return context_.planar ? clearlyFullRank<3>(gram, limit) : clearlyFullRank<6>(gram, limit);
+  return clearlyFullRank<L>(gram, limit);
 }
 
 /// A candidate group's links, sorted and padded with -1, so that the groups sort (and are taken) as sorted
@@ -559,7 +622,8 @@ bool GroupSearch::boundsClearNullity() const {
     frobenius2 += a.squaredNorm();
   }
   const double bound = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
-  return context_.planar ? clearlyFullRank<3>(gram, bound) : clearlyFullRank<6>(gram, bound);
+  return context_.planar ? clearlyFullRank<3>(gram.topLeftCorner<3, 3>().eval(), bound)
+                          : clearlyFullRank<6>(gram, bound);
 }
 
 Eigen::MatrixXd GroupSearch::buildT() const {

@@ -58,7 +58,8 @@ std::optional<Diagnostic> addJointElements(ModelBuilder& builder) {
         if (!model.jointActive[j])
           continue;
       }
-      c.primitives = {Primitive::Distance};
+      static const std::vector<Primitive> kDistance = {Primitive::Distance};
+      c.primitives = kDistance;
       model.jointFreedom[j] = model.lambda - 1;
     } else if (builder.planar()) {
       const PlanarForm form = classifyPlanar(joint, axes.first, axes.second, model.planeNormal);
