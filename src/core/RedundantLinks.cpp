@@ -5,24 +5,11 @@
 
 #include "Buckets.hpp"
 #include "LocalRows.hpp"
+#include "StressMatrix.hpp"
 
 namespace mobility_analysis {
 
 namespace {
-
-/// The stresses by connection equation: Y(r, s) = stress s at joint row r (other rows empty).
-SparseJacobian stressesByJointRow(const CoordinateModel& model, const std::vector<SelfStress>& stresses) {
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (int s = 0; s < static_cast<int>(stresses.size()); ++s) {
-    for (const auto& [row, value] : stresses[s]) {
-      if (model.equations[row].source == EquationSource::Joint)
-        triplets.emplace_back(row, s, value);
-    }
-  }
-  SparseJacobian Y(model.numConstraints(), static_cast<int>(stresses.size()));
-  Y.setFromTriplets(triplets.begin(), triplets.end());
-  return Y;
-}
 
 /// The connection equations of each link, in contract order (pooled: a vector per link cost a braced
 /// lattice's report more than the eliminations).
@@ -58,7 +45,10 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
   if (stresses.empty())
     return redundant;
 
-  const SparseJacobian Y = stressesByJointRow(model, stresses);
+  // The stresses by connection equation: Y(r, s) = stress s at joint row r.
+  const SparseJacobian Y = core_detail::stressMatrix(stresses, model.numConstraints(), [&](int row) {
+    return model.equations[static_cast<size_t>(row)].source == EquationSource::Joint;
+  });
   const core_detail::Buckets rowsOfLink = connectionRowsOfLinks(mechanism, model);
   auto stressesAt = [&](int r) { return Y.outerIndexPtr()[r + 1] - Y.outerIndexPtr()[r]; };
   // Reused from link to link.

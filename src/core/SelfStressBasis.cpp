@@ -10,6 +10,7 @@
 #include "EquationGraph.hpp"
 #include "LocalMemo.hpp"
 #include "LocalRows.hpp"
+#include "StressMatrix.hpp"
 
 namespace mobility_analysis {
 
@@ -482,8 +483,8 @@ class LocalStressFinder {
   bool inSpaceFirst_ = false;
 };
 
-/// When a sweep gives up: past a fixed number of stored entries, or past a multiple of the entries of the rows
-/// it has taken so far (both 0: never).
+/// When a sweep gives up: past a fixed number of stored entries, or past a multiple of the entries of the
+/// rows it has taken so far (both 0: never).
 struct FillBudget {
   size_t entries = 0;
   size_t perRowEntry = 0;  ///< With kFillFloor added.
@@ -597,18 +598,14 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
 std::optional<StressEchelon> reduceStresses(const std::vector<SelfStress>& stresses, int m, double tolerance,
                                             bool limited) {
   const int numStresses = static_cast<int>(stresses.size());
-  std::vector<Eigen::Triplet<double>> triplets;
   std::vector<int> enters(numStresses, -1);  // the stress's last row: where the upward sweep meets it
   size_t entries = 0;
   for (int s = 0; s < numStresses; ++s) {
     entries += stresses[s].size();
-    for (const auto& [row, value] : stresses[s]) {
-      triplets.emplace_back(row, s, value);
-      enters[s] = std::max(enters[s], row);
-    }
+    for (const auto& entry : stresses[s])
+      enters[s] = std::max(enters[s], entry.first);
   }
-  SparseJacobian Y(m, numStresses);
-  Y.setFromTriplets(triplets.begin(), triplets.end());
+  const SparseJacobian Y = core_detail::stressMatrix(stresses, m, [](int) { return true; });
 
   // Rows from the last equation up, unscaled (the stresses are scaled instead, so a row of rounding noise
   // stays noise); the stress that the upward sweep met last is the preferred pivot. Once every stress has
@@ -693,10 +690,11 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
     // grows as the square of the depth); past that it is abandoned for the spanning tree from the leaves and
     // the closing connections after it (a ring: about J's entries), and if that fills as well, the sweep from
     // the ground is run to the end. The budget is checked against the rows taken so far, not all of J: a
-    // quadratic fill passes a fixed budget only after about sqrt(budget) rows and has cost their cube by then,
-    // and it passes the running one after a few thousand rows (a ring of 10^5 links: self-stresses 0.67 ->
-    // 0.37 CPU s, peak 503 -> 294 MB); a sweep whose fill stays linear (every mast, grid and lattice measured,
-    // at most about twice its rows' entries) meets neither, and their reports are unchanged byte for byte.
+    // quadratic fill passes a fixed budget only after about sqrt(budget) rows and has cost their cube by
+    // then, and it passes the running one after a few thousand rows (a ring of 10^5 links: self-stresses 0.67
+    // -> 0.37 CPU s, peak 503 -> 294 MB); a sweep whose fill stays linear (every mast, grid and lattice
+    // measured, at most about twice its rows' entries) meets neither, and their reports are unchanged byte
+    // for byte.
     const FillBudget budget = FillBudget::total(kFillFactor * static_cast<size_t>(J.nonZeros()) + kFillFloor);
     found = sweepBasis(mechanism, model, J, order, tolerance,
                        fillBudget > 0 ? FillBudget::total(fillBudget) : FillBudget::proportional(kFillFactor),

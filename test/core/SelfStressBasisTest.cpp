@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,8 @@
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
+// A private header of the core: its one test is here, beside the reductions that use it.
+#include "../../src/core/StressMatrix.hpp"
 
 using namespace mobility_analysis;
 
@@ -314,4 +317,47 @@ TEST(SelfStressBasis, TheStressesOfAGridOfContinuousBarsStayLocal) {
   EXPECT_LE(static_cast<double>(largeTotal), 4.5 * static_cast<double>(smallTotal))
       << smallTotal << " -> " << largeTotal;
   checkModel(large, "grid 20 x 20", false);
+}
+
+TEST(StressMatrix, EqualsTheTripletMatrixEntryForEntry) {
+  // Counting into compressed rows must give what setFromTriplets gives: random stresses with increasing
+  // equations (the counting path), then one listing an equation twice and out of order (setFromTriplets).
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> row(0, 59);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  std::vector<SelfStress> stresses(25);
+  for (SelfStress& stress : stresses) {
+    std::set<int> rows;
+    while (rows.size() < 6)
+      rows.insert(row(rng));
+    for (int r : rows)
+      stress.emplace_back(r, value(rng));
+  }
+  auto keepEven = [](int r) { return r % 2 == 0; };
+  auto triplets = [&](const std::vector<SelfStress>& given) {
+    std::vector<Eigen::Triplet<double>> list;
+    for (int s = 0; s < static_cast<int>(given.size()); ++s) {
+      for (const auto& [r, v] : given[static_cast<size_t>(s)]) {
+        if (keepEven(r))
+          list.emplace_back(r, s, v);
+      }
+    }
+    SparseJacobian Y(60, static_cast<int>(given.size()));
+    Y.setFromTriplets(list.begin(), list.end());
+    return Y;
+  };
+  auto same = [](const SparseJacobian& a, const SparseJacobian& b) {
+    ASSERT_EQ(a.nonZeros(), b.nonZeros());
+    for (int r = 0; r < a.rows(); ++r) {
+      SparseJacobian::InnerIterator x(a, r), y(b, r);
+      for (; x && y; ++x, ++y) {
+        EXPECT_EQ(x.col(), y.col());
+        EXPECT_EQ(x.value(), y.value());
+      }
+      EXPECT_FALSE(x || y);
+    }
+  };
+  same(core_detail::stressMatrix(stresses, 60, keepEven), triplets(stresses));
+  stresses[3].emplace_back(stresses[3].front().first, 0.25);  // twice, and out of order
+  same(core_detail::stressMatrix(stresses, 60, keepEven), triplets(stresses));
 }
