@@ -98,16 +98,24 @@ void findOverConstrainedLoops(const Mechanism& mechanism, const CoordinateModel&
                               std::vector<bool>& jointInLoop) {
   linkInLoop.assign(mechanism.links.size(), false);
   jointInLoop.assign(mechanism.joints.size(), false);
+  // The equations some stress reaches first, a byte each, then their elements in one pass in equation
+  // order: reading an equation (96 bytes) and its joint (hundreds) for every stress entry missed the cache
+  // on each of the 1.1 10^6 entries of a 200 x 200 braced lattice.
+  std::vector<char> inStress(model.equations.size(), 0);
   for (const SelfStress& stress : stresses) {
-    for (const auto& entry : stress) {
-      const ConstraintEquation& eq = model.equations[entry.first];
-      if (eq.source == EquationSource::Joint) {
-        jointInLoop[eq.element] = true;
-        linkInLoop[mechanism.joints[eq.element].link1] = true;
-        linkInLoop[mechanism.joints[eq.element].link2] = true;
-      } else {
-        linkInLoop[eq.element] = true;
-      }
+    for (const auto& entry : stress)
+      inStress[static_cast<size_t>(entry.first)] = 1;
+  }
+  for (size_t r = 0; r < model.equations.size(); ++r) {
+    if (inStress[r] == 0)
+      continue;
+    const ConstraintEquation& eq = model.equations[r];
+    if (eq.source == EquationSource::Joint) {
+      jointInLoop[eq.element] = true;
+      linkInLoop[mechanism.joints[eq.element].link1] = true;
+      linkInLoop[mechanism.joints[eq.element].link2] = true;
+    } else {
+      linkInLoop[eq.element] = true;
     }
   }
 }
