@@ -11,9 +11,9 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "mobility_analysis/Kinematics.hpp"
+#include "mobility_analysis/analysis/DriveableJoints.hpp"
 #include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/motion/Deployment.hpp"
-#include "mobility_analysis/analysis/DriveableJoints.hpp"
 #include "mobility_analysis/ros/RosConversions.hpp"
 
 namespace mobility_analysis {
