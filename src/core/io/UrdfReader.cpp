@@ -323,11 +323,12 @@ class Reader {
   /// compared first, in cache, before a probe of the index (a hash and two cache misses on 10^5 links).
   int findLink(const char* name) const {
     const std::vector<Link>& links = mechanism_.links;
+    const std::string_view key(name);  // its length once; a guess of another length costs one comparison
     for (const int guess : {lastLink_ + 1, lastLink_}) {
-      if (guess >= 0 && guess < static_cast<int>(links.size()) && links[static_cast<size_t>(guess)].name == name)
+      if (guess >= 0 && guess < static_cast<int>(links.size()) && links[static_cast<size_t>(guess)].name == key)
         return lastLink_ = guess;
     }
-    const int index = linkIndex_.find(name, links);
+    const int index = linkIndex_.find(key, links);
     if (index >= 0)
       lastLink_ = index;
     return index;
