@@ -69,6 +69,15 @@ class SparseElimination {
   void keep();
   /// Room for @p rows pivot rows holding @p entries entries in all (a hint: the storage still grows).
   void reserve(size_t rows, size_t entries);
+  /**
+   * @brief Forgets every row, for a new elimination over @p numColumns columns with the same tolerance and
+   * options, keeping the storage. Why: a local search eliminates thousands of balls of a hundred rows (one
+   * per redundant row of a grid of continuous bars); a fresh elimination per ball grew every pool from empty,
+   * and its allocations cost about as much as the arithmetic.
+   *
+   * Only for the default priorities (the column index): given ones are for the columns they were given for.
+   */
+  void reset(int numColumns);
 
   /**
    * @brief The distance of row @p r of @p J, multiplied by @p scale, from the span of the pivot rows: the
@@ -136,8 +145,11 @@ class SparseElimination {
   /// pivots, so fill only ever reaches later ones. Empty between rows; a member so that no row allocates one.
   std::priority_queue<int, std::vector<int>, std::greater<int>> pending_;
   std::vector<std::pair<int, double>> multipliers_;
+  // traceDependency's workspace: coefficients and flags by pivot (zero between calls), the pivots to expand
+  // (a heap, latest first) and those it touched.
   std::vector<double> coefficient_;
   std::vector<char> traced_;
+  std::vector<int> traceHeap_, traceSeen_;
 
   double smallestKept_ = -1.0;
   double largestDropped_ = 0.0;

@@ -212,7 +212,8 @@ class LocalStressFinder {
         graph_(mechanism, model),
         inBall_(mechanism.links.size(), 0),
         jointTaken_(mechanism.joints.size(), 0),
-        columnMap_(J.cols(), -1) {}
+        columnMap_(J.cols(), -1),
+        localElimination_(0, {}, tolerance, true) {}
 
   /// Whether the ball in space is tried first (it found shorter stresses than the links' ball).
   bool inSpaceFirst() const { return inSpaceFirst_; }
@@ -287,7 +288,8 @@ class LocalStressFinder {
     if (!places_->located(row))
       return std::nullopt;
     const Eigen::Vector3d center = places_->place(row);
-    std::vector<int> rows, links;
+    std::vector<int>& rows = spaceRows_;
+    std::vector<int>& links = spaceLinks_;
     const double start = kSpaceStart * places_->spacing();
     for (double radius = spaceRadius_ > 0.0 ? spaceRadius_ : start;; radius *= kSpaceGrowth) {
       rows.clear();
@@ -444,9 +446,10 @@ class LocalStressFinder {
   }
 
   /// The dependency of @p local's last row on the rows before it (local row numbers), if it is dependent.
-  std::optional<SelfStress> lastDependency(const SparseJacobian& local) const {
+  std::optional<SelfStress> lastDependency(const SparseJacobian& local) {
     // Columns are sorted by sweep priority, so the local column index is the priority.
-    SparseElimination elimination(static_cast<int>(local.cols()), {}, tolerance_, true);
+    SparseElimination& elimination = localElimination_;
+    elimination.reset(static_cast<int>(local.cols()));
     SparseElimination::Step step;
     for (int i = 0; i < local.rows(); ++i) {
       const double norm = local.row(i).norm();
@@ -473,6 +476,8 @@ class LocalStressFinder {
   bool inverseTried_ = false;
   SparseJacobian local_;
   std::vector<std::pair<int, double>> rowScratch_;
+  SparseElimination localElimination_;  ///< Reset for each ball (its pools keep their capacity).
+  std::vector<int> spaceRows_, spaceLinks_;  ///< findInSpace's ball: its rows and the links they reach.
   core_detail::LocalMemo<std::optional<SelfStress>> memo_;
   int lastRadius_ = 1;
   std::optional<EquationPlaces> places_;  ///< Built the first time a ball in space is needed.

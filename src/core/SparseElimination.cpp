@@ -1,6 +1,7 @@
 #include "mobility_analysis/SparseElimination.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <queue>
 
@@ -161,6 +162,26 @@ void SparseElimination::reserve(size_t rows, size_t entries) {
   entries_.reserve(entries);
 }
 
+void SparseElimination::reset(int numColumns) {
+  assert(columnPriority_.empty());
+  origin_.clear();
+  column_.clear();
+  pivot_.clear();
+  entryStart_.assign(1, 0);
+  multiplierStart_.assign(1, 0);
+  entries_.clear();
+  pivotMultipliers_.clear();
+  pivotOfColumn_.assign(static_cast<size_t>(numColumns), -1);
+  values_.assign(static_cast<size_t>(numColumns), 0.0);
+  present_.assign(static_cast<size_t>(numColumns), 0);
+  touched_.clear();
+  queued_.clear();
+  multipliers_.clear();
+  smallestKept_ = -1.0;
+  largestDropped_ = 0.0;
+  reducedRow_ = -1;
+}
+
 std::optional<double> SparseElimination::distanceFromPivotRows(const SparseJacobian& J, int r, double scale,
                                                                size_t maxNullity) const {
   const std::optional<std::vector<Eigen::VectorXd>> basis = nullSpace(maxNullity);
@@ -186,12 +207,15 @@ std::optional<SelfStress> SparseElimination::traceDependency(
   // down from the latest pivot to the first.
   coefficient_.resize(origin_.size(), 0.0);
   traced_.resize(origin_.size(), 0);
-  std::priority_queue<int> queue;  // latest pivot first
-  std::vector<int> seen;
+  std::vector<int>& queue = traceHeap_;  // a heap, latest pivot first
+  std::vector<int>& seen = traceSeen_;
+  queue.clear();
+  seen.clear();
   auto add = [&](int k, double value) {
     if (traced_[k] == 0) {
       traced_[k] = 1;
-      queue.push(k);
+      queue.push_back(k);
+      std::push_heap(queue.begin(), queue.end());
       seen.push_back(k);
     }
     coefficient_[k] += value;
@@ -201,8 +225,9 @@ std::optional<SelfStress> SparseElimination::traceDependency(
   SelfStress stress = {{row, 1.0}};
   bool complete = true;
   while (!queue.empty()) {
-    const int k = queue.top();
-    queue.pop();
+    std::pop_heap(queue.begin(), queue.end());
+    const int k = queue.back();
+    queue.pop_back();
     const double c = coefficient_[k];
     if (std::abs(c) < kDependencyCoefficient)
       continue;
