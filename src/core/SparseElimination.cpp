@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <queue>
 
 #include <Eigen/QR>
 
@@ -75,25 +74,16 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
     }
     values_[column] += value;
   };
-  auto enqueue = [&](int k) {
-    if (queued_[k] == 0) {
-      queued_[k] = 1;
-      pending_.push(k);
-    }
-  };
   if (scale > 0.0) {
     for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
       add(static_cast<int>(it.col()), it.value() * scale);
       const int k = pivotOfColumn_[it.col()];
       if (k >= 0)
-        enqueue(k);
+        pending_.push(k);
     }
   }
-  visited_.clear();
   while (!pending_.empty()) {
-    const int k = pending_.top();
-    pending_.pop();
-    visited_.push_back(k);
+    const int k = pending_.pop();
     const double value = values_[column_[k]];
     if (std::abs(value) <= kCancellationNoise) {
       values_[column_[k]] = 0.0;
@@ -106,12 +96,10 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
       add(column, -multiplier * entry);
       const int later = pivotOfColumn_[column];
       if (later > k)
-        enqueue(later);
+        pending_.push(later);
     }
     values_[column_[k]] = 0.0;
   }
-  for (int k : visited_)
-    queued_[k] = 0;
 
   double squared = 0.0;
   for (int c : touched_)
@@ -149,7 +137,7 @@ void SparseElimination::keep() {
     pivotMultipliers_.insert(pivotMultipliers_.end(), multipliers_.begin(), multipliers_.end());
   multiplierStart_.push_back(pivotMultipliers_.size());
   pivotOfColumn_[pivotColumn] = rank() - 1;
-  queued_.push_back(0);
+  pending_.resize(origin_.size());
 }
 
 void SparseElimination::reserve(size_t rows, size_t entries) {
@@ -158,7 +146,6 @@ void SparseElimination::reserve(size_t rows, size_t entries) {
   pivot_.reserve(rows);
   entryStart_.reserve(rows + 1);
   multiplierStart_.reserve(rows + 1);
-  queued_.reserve(rows);
   entries_.reserve(entries);
 }
 
@@ -175,7 +162,6 @@ void SparseElimination::reset(int numColumns) {
   values_.assign(static_cast<size_t>(numColumns), 0.0);
   present_.assign(static_cast<size_t>(numColumns), 0);
   touched_.clear();
-  queued_.clear();
   multipliers_.clear();
   smallestKept_ = -1.0;
   largestDropped_ = 0.0;
