@@ -198,7 +198,8 @@ class SparseElimination {
 
   double smallestKept_ = -1.0;
   double largestDropped_ = 0.0;
-  int reducedRow_ = -1;  ///< The row the workspace holds reduced (reduce).
+  int reducedRow_ = -1;         ///< The row the workspace holds reduced (reduce).
+  double reducedLargest_ = 0.0;  ///< Its largest entry in magnitude.
 };
 
 }  // namespace mobility_analysis

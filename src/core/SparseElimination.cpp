@@ -101,9 +101,13 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
     values_[column_[k]] = 0.0;
   }
 
+  // The largest entry too, for keep: one pass over the reduced row instead of two.
   double squared = 0.0;
-  for (int c : touched_)
+  reducedLargest_ = 0.0;
+  for (int c : touched_) {
     squared += values_[c] * values_[c];
+    reducedLargest_ = std::max(reducedLargest_, std::abs(values_[c]));
+  }
   Step step;
   step.residual = std::sqrt(squared);
   step.dependent = step.residual <= tolerance_;
@@ -111,27 +115,22 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
 }
 
 void SparseElimination::keep() {
-  double largest = 0.0;
-  for (int c : touched_)
-    largest = std::max(largest, std::abs(values_[c]));
+  const double largest = reducedLargest_;
   if (!(largest > 0.0))
     return;  // nothing to pivot on: a zero row is dependent whatever the tolerance
   // Threshold partial pivoting: among entries within pivotThreshold_ of the largest, the column of lowest
-  // priority.
+  // priority. The entries are stored in the same pass.
   int pivotColumn = -1;
   for (int c : touched_) {
-    if (std::abs(values_[c]) >= pivotThreshold_ * largest &&
-        (pivotColumn < 0 || priority(c) < priority(pivotColumn))) {
+    const double magnitude = std::abs(values_[c]);
+    if (magnitude >= pivotThreshold_ * largest && (pivotColumn < 0 || priority(c) < priority(pivotColumn)))
       pivotColumn = c;
-    }
+    if (magnitude > kDropTolerance * largest)
+      entries_.emplace_back(c, values_[c]);
   }
   origin_.push_back(reducedRow_);
   column_.push_back(pivotColumn);
   pivot_.push_back(values_[pivotColumn]);
-  for (int c : touched_) {
-    if (std::abs(values_[c]) > kDropTolerance * largest)
-      entries_.emplace_back(c, values_[c]);
-  }
   entryStart_.push_back(entries_.size());
   if (keepMultipliers_)
     pivotMultipliers_.insert(pivotMultipliers_.end(), multipliers_.begin(), multipliers_.end());
