@@ -126,11 +126,13 @@ class SparseElimination {
   int priority(int column) const { return columnPriority_.empty() ? column : columnPriority_[column]; }
 
   /**
-   * Pivot indices to reduce the current row by, smallest (oldest) first: a bit per pivot, and a bit per
-   * 64-bit word of them that is not zero. Why not a heap: a row of a local ball meets about five pivots, and
-   * the heap's pushes and pops cost more than reducing by them; here a push sets two bits and a pop reads the
-   * lowest. Pops never go down within a row (P_k is zero at the pivot columns of earlier pivots, so fill only
-   * reaches later ones), so each row scans the summary words at most once.
+   * A set of pivot indices taken smallest first: a bit per pivot, and a bit per 64-bit word of them that is
+   * not zero. It holds the pivots to reduce the current row by (reduce) and, counted from the latest, those
+   * a dependency still has to expand (traceDependency). Why not a heap: a row of a local ball meets about
+   * five pivots, and the heap's pushes and pops cost more than reducing by them; here a push sets two bits and
+   * a pop reads the lowest. Both uses only push above what they last took (P_k is zero at the pivot columns
+   * of earlier pivots, so fill only reaches later ones; a pivot's multipliers refer to earlier ones), so each
+   * row or dependency scans the summary words once.
    */
   class PivotQueue {
    public:
@@ -149,6 +151,11 @@ class SparseElimination {
       words_[word >> 6] |= uint64_t{1} << (word & 63);
       lowestSummary_ = std::min(lowestSummary_, word >> 6);
       ++size_;
+    }
+    /// Empties the queue.
+    void clear() {
+      while (!empty())
+        pop();
     }
     /// Removes and returns the smallest pivot (the queue must not be empty).
     int pop() {
@@ -191,10 +198,11 @@ class SparseElimination {
   PivotQueue pending_;  ///< Empty between rows; a member so that no row allocates one.
   std::vector<std::pair<int, double>> multipliers_;
   // traceDependency's workspace: coefficients and flags by pivot (zero between calls), the pivots to expand
-  // (a heap, latest first) and those it touched.
+  // and those it touched.
   std::vector<double> coefficient_;
   std::vector<char> traced_;
-  std::vector<int> traceHeap_, traceSeen_;
+  PivotQueue traceQueue_;
+  std::vector<int> traceSeen_;
 
   double smallestKept_ = -1.0;
   double largestDropped_ = 0.0;

@@ -3,6 +3,8 @@
 // Private to src/core: the local stress searches (SelfStressBasis.cpp, ContractEchelon.cpp,
 // analysis/Prestress.cpp) copy a few rows of J into a small matrix through it.
 
+#include <cassert>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -10,6 +12,17 @@
 
 namespace mobility_analysis {
 namespace core_detail {
+
+/// The norm of row @p r of @p J: the same sum, in the same order, as J.row(r).norm(), without building the
+/// row's block expression (a local search takes it for every row of every ball).
+inline double rowNorm(const SparseJacobian& J, int r) {
+  assert(J.isCompressed());
+  const double* value = J.valuePtr();
+  double squared = 0.0;
+  for (int i = J.outerIndexPtr()[r]; i < J.outerIndexPtr()[r + 1]; ++i)
+    squared += value[i] * value[i];
+  return std::sqrt(squared);
+}
 
 /**
  * Rows @p rows of @p J, in that order, over their columns renumbered by @p localOf (global column -> local

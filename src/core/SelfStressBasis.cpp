@@ -323,7 +323,7 @@ class LocalStressFinder {
       }
       if (rows.size() > kLocalLimit)
         return std::nullopt;
-      std::sort(rows.begin(), rows.end(), [&](int a, int b) { return position_[a] < position_[b]; });
+      sortBySweep(rows);
       if (std::optional<SelfStress> found = eliminate(rows)) {
         // The next row starts where this one succeeded (a regular structure needs the same radius), but a
         // global stress must not make every later ball global.
@@ -366,8 +366,18 @@ class LocalStressFinder {
     }
     for (int j : joints_)
       jointTaken_[j] = 0;
-    std::sort(rows.begin(), rows.end(), [&](int a, int b) { return position_[a] < position_[b]; });
+    sortBySweep(rows);
     return rows;
+  }
+
+  /// @p rows in sweep order. Their positions are sorted and read back through the order (every row is in it
+  /// once): the same order as sorting the rows by position, without the indirection in every comparison.
+  void sortBySweep(std::vector<int>& rows) const {
+    for (int& r : rows)
+      r = position_[r];
+    std::sort(rows.begin(), rows.end());
+    for (int& r : rows)
+      r = order_.rows[static_cast<size_t>(r)];
   }
 
   /// The elimination of @p rows (the last one the row in question): its dependency, if it is dependent.
@@ -452,7 +462,7 @@ class LocalStressFinder {
     elimination.reset(static_cast<int>(local.cols()));
     SparseElimination::Step step;
     for (int i = 0; i < local.rows(); ++i) {
-      const double norm = local.row(i).norm();
+      const double norm = core_detail::rowNorm(local, i);
       step = elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0);
     }
     if (!step.dependent)

@@ -190,17 +190,18 @@ std::optional<SelfStress> SparseElimination::traceDependency(
     int row, const std::vector<std::pair<int, double>>& multipliers, size_t maxSupport) {
   // J_row = sum_k c_k P_k, and each P_k expands into J_origin(k) and earlier pivots: push the coefficients
   // down from the latest pivot to the first.
+  // The pivots to expand, latest first: a PivotQueue of (latest - k), as a pivot's multipliers only refer to
+  // earlier pivots.
+  const int latest = rank() - 1;
   coefficient_.resize(origin_.size(), 0.0);
   traced_.resize(origin_.size(), 0);
-  std::vector<int>& queue = traceHeap_;  // a heap, latest pivot first
+  traceQueue_.resize(origin_.size());
   std::vector<int>& seen = traceSeen_;
-  queue.clear();
   seen.clear();
   auto add = [&](int k, double value) {
     if (traced_[k] == 0) {
       traced_[k] = 1;
-      queue.push_back(k);
-      std::push_heap(queue.begin(), queue.end());
+      traceQueue_.push(latest - k);
       seen.push_back(k);
     }
     coefficient_[k] += value;
@@ -209,10 +210,8 @@ std::optional<SelfStress> SparseElimination::traceDependency(
     add(k, m);
   SelfStress stress = {{row, 1.0}};
   bool complete = true;
-  while (!queue.empty()) {
-    std::pop_heap(queue.begin(), queue.end());
-    const int k = queue.back();
-    queue.pop_back();
+  while (!traceQueue_.empty()) {
+    const int k = latest - traceQueue_.pop();
     const double c = coefficient_[k];
     if (std::abs(c) < kDependencyCoefficient)
       continue;
@@ -225,6 +224,7 @@ std::optional<SelfStress> SparseElimination::traceDependency(
       add(pivotMultipliers_[i].first, -c * pivotMultipliers_[i].second);
     }
   }
+  traceQueue_.clear();  // not empty when the support grew past maxSupport
   for (int k : seen) {
     coefficient_[k] = 0.0;
     traced_[k] = 0;
