@@ -91,14 +91,19 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
     }
     const double multiplier = value / pivot_[k];
     multipliers_.emplace_back(k, multiplier);
+    // Not at P_k's pivot column: it is set to zero below, and it is in the row already (P_k is queued when
+    // its pivot column is added).
+    const int pivotColumn = column_[k];
     for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
       const auto [column, entry] = entries_[i];
+      if (column == pivotColumn)
+        continue;
       add(column, -multiplier * entry);
       const int later = pivotOfColumn_[column];
       if (later > k)
         pending_.push(later);
     }
-    values_[column_[k]] = 0.0;
+    values_[pivotColumn] = 0.0;
   }
 
   // The largest entry too, for keep: one pass over the reduced row instead of two.
