@@ -601,12 +601,7 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
 }
 
 /// The echelon form of a set of stresses on their last equations (computeOrderedRankFromStresses).
-struct StressReduction {
-  std::vector<char> pivot;  ///< Per equation: a pivot of the reduction (the equation is redundant).
-  int rank = 0;
-  double smallestKeptPivot = 0.0;
-  double largestDroppedResidual = 0.0;
-};
+using StressReduction = SelfStressBasis::EchelonReduction;
 
 /**
  * The rows of Y (one column per stress) from the last equation up, each kept when it is independent of the
@@ -645,6 +640,7 @@ std::optional<StressReduction> reduceStresses(const std::vector<SelfStress>& str
     columnPriority[byEntering[k]] = k;
   SparseElimination elimination(numStresses, std::move(columnPriority), tolerance, false);
   StressReduction reduction;
+  reduction.tolerance = tolerance;
   reduction.pivot.assign(m, 0);
   for (int r = m - 1; r >= 0 && elimination.rank() < numStresses; --r) {
     if (fillBudget > 0 && elimination.storedEntries() > fillBudget)
@@ -745,11 +741,14 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
       isLast[stress.back().first] = 1;
     }
   }
-  if (!ownLastRows && !reduceStresses(basis.stresses, static_cast<int>(J.rows()), tolerance,
-                                      kEchelonFillFactor * entries + kEchelonFillFloor)) {
-    if (std::optional<std::vector<SelfStress>> echelon =
-            findContractEchelon(mechanism, model, J, basis.stresses, tolerance))
-      basis.contractEchelon = std::move(*echelon);
+  if (!ownLastRows) {
+    basis.stressReduction = reduceStresses(basis.stresses, static_cast<int>(J.rows()), tolerance,
+                                           kEchelonFillFactor * entries + kEchelonFillFloor);
+    if (!basis.stressReduction) {
+      if (std::optional<std::vector<SelfStress>> echelon =
+              findContractEchelon(mechanism, model, J, basis.stresses, tolerance))
+        basis.contractEchelon = std::move(*echelon);
+    }
   }
   return basis;
 }
@@ -771,7 +770,10 @@ std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis&
       !basis.contractEchelon.empty() && basis.contractEchelon.size() == basis.stresses.size();
   const std::vector<SelfStress>& stresses = echelon ? basis.contractEchelon : basis.stresses;
   if (!stresses.empty()) {
-    const std::optional<StressReduction> reduction = reduceStresses(stresses, m, tolerance, 0);
+    // The reduction computeSelfStressBasis made (within its budget, so the same as an unbounded one).
+    const bool made = !echelon && basis.stressReduction && basis.stressReduction->tolerance == tolerance;
+    const std::optional<StressReduction> reduction =
+        made ? basis.stressReduction : reduceStresses(stresses, m, tolerance, 0);
     if (!reduction || reduction->rank != static_cast<int>(stresses.size()))
       return std::nullopt;
     for (int r = 0; r < m; ++r)
