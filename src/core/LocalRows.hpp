@@ -30,37 +30,37 @@ inline double rowNorm(const SparseJacobian& J, int r) {
  * entries by increasing local index, values as in J), but straight into @p local's storage, which keeps its
  * capacity from call to call. Why: a local search builds thousands of such matrices of a few hundred rows
  * (one per cable of a braced lattice, one per redundant row of the sweep); their triplet lists, the sort
- * and the allocations cost about half as much as eliminating them.
- * @param[in,out] scratch one row's entries, reused.
+ * and the allocations cost about half as much as eliminating them. Each entry is sorted into place as it is
+ * written (insertion: a row has a handful of entries, and their local order is nearly J's).
  */
 template <class LocalOf>
 void copyRows(const SparseJacobian& J, const std::vector<int>& rows, LocalOf&& localOf, int numColumns,
-              SparseJacobian& local, std::vector<std::pair<int, double>>& scratch) {
+              SparseJacobian& local) {
+  assert(J.isCompressed());
+  const int* rowStart = J.outerIndexPtr();
+  const int* column = J.innerIndexPtr();
+  const double* value = J.valuePtr();
   Eigen::Index entries = 0;
   for (int r : rows)
-    entries += J.row(r).nonZeros();
+    entries += rowStart[r + 1] - rowStart[r];
   local.resize(static_cast<Eigen::Index>(rows.size()), numColumns);
   local.resizeNonZeros(entries);
   int* outer = local.outerIndexPtr();
   int* inner = local.innerIndexPtr();
-  double* value = local.valuePtr();
+  double* localValue = local.valuePtr();
   int written = 0;
   for (size_t i = 0; i < rows.size(); ++i) {
-    outer[i] = written;
-    scratch.clear();
-    for (SparseJacobian::InnerIterator it(J, rows[i]); it; ++it)
-      scratch.emplace_back(localOf(static_cast<int>(it.col())), it.value());
-    // Insertion sort: a row has a handful of entries, and their local order is nearly J's.
-    for (size_t a = 1; a < scratch.size(); ++a) {
-      const std::pair<int, double> entry = scratch[a];
-      size_t b = a;
-      for (; b > 0 && scratch[b - 1].first > entry.first; --b)
-        scratch[b] = scratch[b - 1];
-      scratch[b] = entry;
-    }
-    for (const auto& [column, v] : scratch) {
-      inner[written] = column;
-      value[written] = v;
+    const int begin = written;
+    outer[i] = begin;
+    for (int p = rowStart[rows[i]]; p < rowStart[rows[i] + 1]; ++p) {
+      const int c = localOf(column[p]);
+      int b = written;
+      for (; b > begin && inner[b - 1] > c; --b) {
+        inner[b] = inner[b - 1];
+        localValue[b] = localValue[b - 1];
+      }
+      inner[b] = c;
+      localValue[b] = value[p];
       ++written;
     }
   }

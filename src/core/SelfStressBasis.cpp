@@ -411,8 +411,7 @@ class LocalStressFinder {
       columnMap_[columns[c]] = static_cast<int>(c);
     SparseJacobian& local = local_;
     core_detail::copyRows(
-        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local,
-        rowScratch_);
+        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local);
     for (int c : columns)
       columnMap_[c] = -1;
 
@@ -485,7 +484,6 @@ class LocalStressFinder {
   std::vector<int> columnOfPriority_;  ///< Inverse of order_.columnPriority where that is a permutation.
   bool inverseTried_ = false;
   SparseJacobian local_;
-  std::vector<std::pair<int, double>> rowScratch_;
   SparseElimination localElimination_;  ///< Reset for each ball (its pools keep their capacity).
   std::vector<int> spaceRows_, spaceLinks_;  ///< findInSpace's ball: its rows and the links they reach.
   core_detail::LocalMemo<std::optional<SelfStress>> memo_;
