@@ -67,41 +67,36 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
   }
   touched_.clear();
   multipliers_.clear();
-  auto add = [&](int column, double value) {
-    if (present_[column] == 0) {
-      present_[column] = 1;
-      touched_.push_back(column);
-    }
+  // A column's pivot is queued when the column first enters the row, if it is one still to come: pivots are
+  // taken in increasing order, so one that is not queued then never is, and one that is stays queued until
+  // it is taken; later additions to the column need not look.
+  auto add = [&](int column, double value, int after) {
     values_[column] += value;
+    if (present_[column] != 0)
+      return;
+    present_[column] = 1;
+    touched_.push_back(column);
+    const int pivot = pivotOfColumn_[column];
+    if (pivot > after)
+      pending_.push(pivot);
   };
   if (scale > 0.0) {
-    for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
-      add(static_cast<int>(it.col()), it.value() * scale);
-      const int k = pivotOfColumn_[it.col()];
-      if (k >= 0)
-        pending_.push(k);
-    }
+    for (SparseJacobian::InnerIterator it(J, r); it; ++it)
+      add(static_cast<int>(it.col()), it.value() * scale, -1);
   }
   while (!pending_.empty()) {
     const int k = pending_.pop();
-    const double value = values_[column_[k]];
+    const int pivotColumn = column_[k];
+    const double value = values_[pivotColumn];
     if (std::abs(value) <= kCancellationNoise) {
-      values_[column_[k]] = 0.0;
+      values_[pivotColumn] = 0.0;
       continue;
     }
     const double multiplier = value / pivot_[k];
     multipliers_.emplace_back(k, multiplier);
-    // Not at P_k's pivot column: it is set to zero below, and it is in the row already (P_k is queued when
-    // its pivot column is added).
-    const int pivotColumn = column_[k];
     for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
       const auto [column, entry] = entries_[i];
-      if (column == pivotColumn)
-        continue;
-      add(column, -multiplier * entry);
-      const int later = pivotOfColumn_[column];
-      if (later > k)
-        pending_.push(later);
+      add(column, -multiplier * entry, k);
     }
     values_[pivotColumn] = 0.0;
   }
