@@ -120,13 +120,22 @@ void SparseElimination::keep() {
     return;  // nothing to pivot on: a zero row is dependent whatever the tolerance
   // Threshold partial pivoting: among entries within pivotThreshold_ of the largest, the column of lowest
   // priority. The entries are stored in the same pass.
+  const double pivotFloor = pivotThreshold_ * largest;
+  const double dropFloor = kDropTolerance * largest;
   int pivotColumn = -1;
+  int pivotPriority = 0;
   for (int c : touched_) {
-    const double magnitude = std::abs(values_[c]);
-    if (magnitude >= pivotThreshold_ * largest && (pivotColumn < 0 || priority(c) < priority(pivotColumn)))
-      pivotColumn = c;
-    if (magnitude > kDropTolerance * largest)
-      entries_.emplace_back(c, values_[c]);
+    const double value = values_[c];
+    const double magnitude = std::abs(value);
+    if (magnitude >= pivotFloor) {
+      const int p = priority(c);
+      if (pivotColumn < 0 || p < pivotPriority) {
+        pivotColumn = c;
+        pivotPriority = p;
+      }
+    }
+    if (magnitude > dropFloor)
+      entries_.emplace_back(c, value);
   }
   origin_.push_back(reducedRow_);
   column_.push_back(pivotColumn);
