@@ -1,8 +1,9 @@
 #pragma once
 
+#include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <optional>
-#include <queue>
 #include <utility>
 #include <vector>
 
@@ -69,6 +70,15 @@ class SparseElimination {
   void keep();
   /// Room for @p rows pivot rows holding @p entries entries in all (a hint: the storage still grows).
   void reserve(size_t rows, size_t entries);
+  /**
+   * @brief Forgets every row, for a new elimination over @p numColumns columns with the same tolerance and
+   * options, keeping the storage. Why: a local search eliminates thousands of balls of a hundred rows (one
+   * per redundant row of a grid of continuous bars); a fresh elimination per ball grew every pool from empty,
+   * and its allocations cost about as much as the arithmetic.
+   *
+   * Only for the default priorities (the column index): given ones are for the columns they were given for.
+   */
+  void reset(int numColumns);
 
   /**
    * @brief The distance of row @p r of @p J, multiplied by @p scale, from the span of the pivot rows: the
@@ -115,6 +125,59 @@ class SparseElimination {
  private:
   int priority(int column) const { return columnPriority_.empty() ? column : columnPriority_[column]; }
 
+  /**
+   * A set of pivot indices taken smallest first: a bit per pivot, and a bit per 64-bit word of them that is
+   * not zero. It holds the pivots to reduce the current row by (reduce) and, counted from the latest, those
+   * a dependency still has to expand (traceDependency). Why not a heap: a row of a local ball meets about
+   * five pivots, and the heap's pushes and pops cost more than reducing by them; here a push sets two bits and
+   * a pop reads the lowest. Both uses only push above what they last took (P_k is zero at the pivot columns
+   * of earlier pivots, so fill only reaches later ones; a pivot's multipliers refer to earlier ones), so each
+   * row or dependency scans the summary words once.
+   */
+  class PivotQueue {
+   public:
+    /// Room for pivots 0 .. @p size - 1.
+    void resize(size_t size) {
+      bits_.resize((size + 63) / 64, 0);
+      words_.resize((bits_.size() + 63) / 64, 0);
+    }
+    bool empty() const { return size_ == 0; }
+    void push(int k) {
+      const size_t word = static_cast<size_t>(k) >> 6;
+      const uint64_t bit = uint64_t{1} << (k & 63);
+      if ((bits_[word] & bit) != 0)
+        return;
+      bits_[word] |= bit;
+      words_[word >> 6] |= uint64_t{1} << (word & 63);
+      lowestSummary_ = std::min(lowestSummary_, word >> 6);
+      ++size_;
+    }
+    /// Empties the queue.
+    void clear() {
+      while (!empty())
+        pop();
+    }
+    /// Removes and returns the smallest pivot (the queue must not be empty).
+    int pop() {
+      while (words_[lowestSummary_] == 0)
+        ++lowestSummary_;
+      const size_t word = (lowestSummary_ << 6) + static_cast<size_t>(__builtin_ctzll(words_[lowestSummary_]));
+      const int k = static_cast<int>((word << 6) + static_cast<size_t>(__builtin_ctzll(bits_[word])));
+      bits_[word] &= bits_[word] - 1;
+      if (bits_[word] == 0)
+        words_[word >> 6] &= ~(uint64_t{1} << (word & 63));
+      if (--size_ == 0)
+        lowestSummary_ = kNone;
+      return k;
+    }
+
+   private:
+    static constexpr size_t kNone = static_cast<size_t>(-1);
+    std::vector<uint64_t> bits_, words_;
+    size_t size_ = 0;
+    size_t lowestSummary_ = kNone;  ///< No summary word below it is set.
+  };
+
   std::vector<int> columnPriority_;
   double tolerance_;
   double pivotThreshold_;
@@ -130,18 +193,21 @@ class SparseElimination {
 
   // Workspace, reused across rows.
   std::vector<double> values_;
-  std::vector<char> present_, queued_;
-  std::vector<int> touched_, visited_;
-  /// Pivot indices to reduce the current row by, oldest first: P_k is zero at the pivot columns of earlier
-  /// pivots, so fill only ever reaches later ones. Empty between rows; a member so that no row allocates one.
-  std::priority_queue<int, std::vector<int>, std::greater<int>> pending_;
+  std::vector<char> present_;
+  std::vector<int> touched_;
+  PivotQueue pending_;  ///< Empty between rows; a member so that no row allocates one.
   std::vector<std::pair<int, double>> multipliers_;
+  // traceDependency's workspace: coefficients and flags by pivot (zero between calls), the pivots to expand
+  // and those it touched.
   std::vector<double> coefficient_;
   std::vector<char> traced_;
+  PivotQueue traceQueue_;
+  std::vector<int> traceSeen_;
 
   double smallestKept_ = -1.0;
   double largestDropped_ = 0.0;
-  int reducedRow_ = -1;  ///< The row the workspace holds reduced (reduce).
+  int reducedRow_ = -1;         ///< The row the workspace holds reduced (reduce).
+  double reducedLargest_ = 0.0;  ///< Its largest entry in magnitude.
 };
 
 }  // namespace mobility_analysis

@@ -160,8 +160,7 @@ class Patches {
       columnMap_[columns[c]] = static_cast<int>(c);
     SparseJacobian& local = local_;
     core_detail::copyRows(
-        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local,
-        rowScratch_);
+        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local);
     for (int c : columns)
       columnMap_[c] = -1;
 
@@ -252,7 +251,6 @@ class Patches {
   // A patch's key is its whole matrix (about 130 kB at radius 5): the 200 x 200 braced lattice's 4 394
   // patches have 1 127 distinct ones, 138 MB, of which the default budget held 550.
   core_detail::LocalMemo<PatchOutcome> memo_{size_t{160} << 20};
-  std::vector<std::pair<int, double>> rowScratch_;
 };
 
 }  // namespace

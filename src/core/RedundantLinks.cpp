@@ -54,7 +54,6 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
   // Reused from link to link.
   std::vector<int> columnOf(stresses.size(), -1), columns, rows;
   SparseJacobian Yl;
-  std::vector<std::pair<int, double>> scratch;
   for (int l = 0; l < numLinks; ++l) {
     const core_detail::BucketRange linkRows = rowsOfLink[l];
     const int k = static_cast<int>(linkRows.size());
@@ -79,7 +78,7 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
       rows.assign(linkRows.begin(), linkRows.end());
       std::stable_sort(rows.begin(), rows.end(), [&](int a, int b) { return stressesAt(a) < stressesAt(b); });
       core_detail::copyRows(
-          Y, rows, [&](int column) { return columnOf[column]; }, numColumns, Yl, scratch);
+          Y, rows, [&](int column) { return columnOf[column]; }, numColumns, Yl);
       SparseElimination elimination(numColumns, {}, tolerance, false);
       for (int i = 0; i < k && elimination.rank() < numColumns; ++i) {
         const double norm = Yl.row(i).norm();

@@ -1,8 +1,8 @@
 #include "mobility_analysis/SparseElimination.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
-#include <queue>
 
 #include <Eigen/QR>
 
@@ -67,54 +67,47 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
   }
   touched_.clear();
   multipliers_.clear();
-  auto add = [&](int column, double value) {
-    if (present_[column] == 0) {
-      present_[column] = 1;
-      touched_.push_back(column);
-    }
+  // A column's pivot is queued when the column first enters the row, if it is one still to come: pivots are
+  // taken in increasing order, so one that is not queued then never is, and one that is stays queued until
+  // it is taken; later additions to the column need not look.
+  auto add = [&](int column, double value, int after) {
     values_[column] += value;
-  };
-  auto enqueue = [&](int k) {
-    if (queued_[k] == 0) {
-      queued_[k] = 1;
-      pending_.push(k);
-    }
+    if (present_[column] != 0)
+      return;
+    present_[column] = 1;
+    touched_.push_back(column);
+    const int pivot = pivotOfColumn_[column];
+    if (pivot > after)
+      pending_.push(pivot);
   };
   if (scale > 0.0) {
-    for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
-      add(static_cast<int>(it.col()), it.value() * scale);
-      const int k = pivotOfColumn_[it.col()];
-      if (k >= 0)
-        enqueue(k);
-    }
+    for (SparseJacobian::InnerIterator it(J, r); it; ++it)
+      add(static_cast<int>(it.col()), it.value() * scale, -1);
   }
-  visited_.clear();
   while (!pending_.empty()) {
-    const int k = pending_.top();
-    pending_.pop();
-    visited_.push_back(k);
-    const double value = values_[column_[k]];
+    const int k = pending_.pop();
+    const int pivotColumn = column_[k];
+    const double value = values_[pivotColumn];
     if (std::abs(value) <= kCancellationNoise) {
-      values_[column_[k]] = 0.0;
+      values_[pivotColumn] = 0.0;
       continue;
     }
     const double multiplier = value / pivot_[k];
     multipliers_.emplace_back(k, multiplier);
     for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
       const auto [column, entry] = entries_[i];
-      add(column, -multiplier * entry);
-      const int later = pivotOfColumn_[column];
-      if (later > k)
-        enqueue(later);
+      add(column, -multiplier * entry, k);
     }
-    values_[column_[k]] = 0.0;
+    values_[pivotColumn] = 0.0;
   }
-  for (int k : visited_)
-    queued_[k] = 0;
 
+  // The largest entry too, for keep: one pass over the reduced row instead of two.
   double squared = 0.0;
-  for (int c : touched_)
+  reducedLargest_ = 0.0;
+  for (int c : touched_) {
     squared += values_[c] * values_[c];
+    reducedLargest_ = std::max(reducedLargest_, std::abs(values_[c]));
+  }
   Step step;
   step.residual = std::sqrt(squared);
   step.dependent = step.residual <= tolerance_;
@@ -122,33 +115,37 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
 }
 
 void SparseElimination::keep() {
-  double largest = 0.0;
-  for (int c : touched_)
-    largest = std::max(largest, std::abs(values_[c]));
+  const double largest = reducedLargest_;
   if (!(largest > 0.0))
     return;  // nothing to pivot on: a zero row is dependent whatever the tolerance
   // Threshold partial pivoting: among entries within pivotThreshold_ of the largest, the column of lowest
-  // priority.
+  // priority. The entries are stored in the same pass.
+  const double pivotFloor = pivotThreshold_ * largest;
+  const double dropFloor = kDropTolerance * largest;
   int pivotColumn = -1;
+  int pivotPriority = 0;
   for (int c : touched_) {
-    if (std::abs(values_[c]) >= pivotThreshold_ * largest &&
-        (pivotColumn < 0 || priority(c) < priority(pivotColumn))) {
-      pivotColumn = c;
+    const double value = values_[c];
+    const double magnitude = std::abs(value);
+    if (magnitude >= pivotFloor) {
+      const int p = priority(c);
+      if (pivotColumn < 0 || p < pivotPriority) {
+        pivotColumn = c;
+        pivotPriority = p;
+      }
     }
+    if (magnitude > dropFloor)
+      entries_.emplace_back(c, value);
   }
   origin_.push_back(reducedRow_);
   column_.push_back(pivotColumn);
   pivot_.push_back(values_[pivotColumn]);
-  for (int c : touched_) {
-    if (std::abs(values_[c]) > kDropTolerance * largest)
-      entries_.emplace_back(c, values_[c]);
-  }
   entryStart_.push_back(entries_.size());
   if (keepMultipliers_)
     pivotMultipliers_.insert(pivotMultipliers_.end(), multipliers_.begin(), multipliers_.end());
   multiplierStart_.push_back(pivotMultipliers_.size());
   pivotOfColumn_[pivotColumn] = rank() - 1;
-  queued_.push_back(0);
+  pending_.resize(origin_.size());
 }
 
 void SparseElimination::reserve(size_t rows, size_t entries) {
@@ -157,8 +154,26 @@ void SparseElimination::reserve(size_t rows, size_t entries) {
   pivot_.reserve(rows);
   entryStart_.reserve(rows + 1);
   multiplierStart_.reserve(rows + 1);
-  queued_.reserve(rows);
   entries_.reserve(entries);
+}
+
+void SparseElimination::reset(int numColumns) {
+  assert(columnPriority_.empty());
+  origin_.clear();
+  column_.clear();
+  pivot_.clear();
+  entryStart_.assign(1, 0);
+  multiplierStart_.assign(1, 0);
+  entries_.clear();
+  pivotMultipliers_.clear();
+  pivotOfColumn_.assign(static_cast<size_t>(numColumns), -1);
+  values_.assign(static_cast<size_t>(numColumns), 0.0);
+  present_.assign(static_cast<size_t>(numColumns), 0);
+  touched_.clear();
+  multipliers_.clear();
+  smallestKept_ = -1.0;
+  largestDropped_ = 0.0;
+  reducedRow_ = -1;
 }
 
 std::optional<double> SparseElimination::distanceFromPivotRows(const SparseJacobian& J, int r, double scale,
@@ -184,14 +199,18 @@ std::optional<SelfStress> SparseElimination::traceDependency(
     int row, const std::vector<std::pair<int, double>>& multipliers, size_t maxSupport) {
   // J_row = sum_k c_k P_k, and each P_k expands into J_origin(k) and earlier pivots: push the coefficients
   // down from the latest pivot to the first.
+  // The pivots to expand, latest first: a PivotQueue of (latest - k), as a pivot's multipliers only refer to
+  // earlier pivots.
+  const int latest = rank() - 1;
   coefficient_.resize(origin_.size(), 0.0);
   traced_.resize(origin_.size(), 0);
-  std::priority_queue<int> queue;  // latest pivot first
-  std::vector<int> seen;
+  traceQueue_.resize(origin_.size());
+  std::vector<int>& seen = traceSeen_;
+  seen.clear();
   auto add = [&](int k, double value) {
     if (traced_[k] == 0) {
       traced_[k] = 1;
-      queue.push(k);
+      traceQueue_.push(latest - k);
       seen.push_back(k);
     }
     coefficient_[k] += value;
@@ -200,9 +219,8 @@ std::optional<SelfStress> SparseElimination::traceDependency(
     add(k, m);
   SelfStress stress = {{row, 1.0}};
   bool complete = true;
-  while (!queue.empty()) {
-    const int k = queue.top();
-    queue.pop();
+  while (!traceQueue_.empty()) {
+    const int k = latest - traceQueue_.pop();
     const double c = coefficient_[k];
     if (std::abs(c) < kDependencyCoefficient)
       continue;
@@ -215,6 +233,7 @@ std::optional<SelfStress> SparseElimination::traceDependency(
       add(pivotMultipliers_[i].first, -c * pivotMultipliers_[i].second);
     }
   }
+  traceQueue_.clear();  // not empty when the support grew past maxSupport
   for (int k : seen) {
     coefficient_[k] = 0.0;
     traced_[k] = 0;

@@ -182,7 +182,6 @@ struct BallWorkspace {
   std::vector<int> ball, columns, entryColumn, rowStart, kept, keptRows;
   LonelyRowPeeler peeler;
   SparseJacobian local;
-  std::vector<std::pair<int, double>> rowScratch;
   core_detail::LocalMemo<BallOutcome> memo;
   core_detail::LocalMemo<std::vector<char>> peelMemo;
 };
@@ -358,7 +357,7 @@ std::optional<SelfStress> localStressAround(const SparseJacobian& J,
     SparseJacobian& local = work.local;
     core_detail::copyRows(
         J, work.keptRows, [&](int column) { return work.columnLocal[column]; },
-        static_cast<int>(columns.size()), local, work.rowScratch);
+        static_cast<int>(columns.size()), local);
     // The same ball elsewhere (a regular structure) gives the same outcome to the bit (LocalMemo): its
     // elimination reads the local matrix and each kept row's norm and kind, nothing else.
     core_detail::LocalMemo<BallOutcome>& memo = work.memo;
