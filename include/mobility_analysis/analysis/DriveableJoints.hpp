@@ -17,10 +17,10 @@ constexpr int kMaxDriveableSearchCoordinates = 3000;
  * before it over the null space of the constraint Jacobian (so at most `dof` of them; a passive motion such
  * as a rod spinning between two ball joints moves no joint and adds none).
  *
- * The null space comes from a dense SVD (singular values below 1e-9 of the largest); each joint's rate along a
- * null vector from recovering the link poses at q ± eps n. A planar analysis takes its rates from the spatial
- * model at the same pose (planar coordinates do not give the links' turns back); at most `report.dof` joints
- * are chosen. Used by `~move` (free_direction) and `~animate`.
+ * The null space comes from a dense rank-revealing QR of the Jacobian's transpose (threshold 1e-9); each
+ * joint's rate along a null vector from recovering the link poses at q ± eps n. A planar analysis takes its
+ * rates from the spatial model at the same pose (planar coordinates do not give the links' turns back); at
+ * most `report.dof` joints are chosen. Used by `~move` (free_direction) and `~animate`.
  * @return The joint names; empty when the model has more than kMaxDriveableSearchCoordinates coordinates.
  */
 std::vector<std::string> findDriveableJoints(const Mechanism& mechanism, const MobilityAnalysis& analysis);

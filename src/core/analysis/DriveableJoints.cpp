@@ -44,9 +44,10 @@ std::vector<std::string> findDriveableJoints(const Mechanism& mechanism, const M
   if (J.rows() == 0) {
     nullSpace = Eigen::MatrixXd::Identity(model->numCoordinates(), model->numCoordinates());
   } else {
-    // A rank-revealing QR of Jᵀ: Jᵀ P = Q R, so the last n − rank columns of Q are an orthonormal basis of the
-    // null space (the joint choice below only needs some orthonormal basis: it is invariant under rotating it).
-    // A full SVD gives the same space; its divide-and-conquer template alone cost a minute of every build.
+    // A rank-revealing QR of Jᵀ: Jᵀ P = Q R, so the last n − rank columns of Q are an orthonormal basis of
+    // the null space (the joint choice below only needs some orthonormal basis: it is invariant under
+    // rotating it). A full SVD gives the same space; its divide-and-conquer template alone cost a minute of
+    // every build.
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J.transpose());
     qr.setThreshold(kNullTolerance);
     const Eigen::MatrixXd orthonormal = qr.householderQ();
