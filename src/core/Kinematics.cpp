@@ -24,7 +24,8 @@ Eigen::Isometry3d jointMotion(const Joint& joint, double value) {
 }
 
 /**
- * @brief The map of @p values (name, value), the last value of a name kept, as operator[] in their order gave.
+ * @brief The map of @p values (name, value), the last value of a name kept, as operator[] in their order
+ * gave.
  *
  * Joint names are rarely written in their lexicographic order (joint_9 before joint_10): inserted in joint
  * order, each would search the map (a dozen string comparisons and as many cache misses on 10^5 joints).
@@ -65,7 +66,8 @@ LinkPoses computeTreePoses(const Mechanism& mechanism, const JointPositions& pos
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
       const Joint& joint = mechanism.joints[parentJoint[*it]];
       const auto value = positions.find(joint.name);
-      poses[*it] = poses[joint.link1] * joint.frame1 * jointMotion(joint, value == positions.end() ? 0.0 : value->second);
+      poses[*it] = poses[joint.link1] * joint.frame1 *
+                   jointMotion(joint, value == positions.end() ? 0.0 : value->second);
       done[*it] = true;
     }
   }
@@ -97,7 +99,8 @@ JointPositions computeJointPositions(const Mechanism& mechanism, const LinkPoses
   return toJointPositions(values);
 }
 
-double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int jointIndex, double lengthScale) {
+double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int jointIndex,
+                            double lengthScale) {
   const Joint& joint = mechanism.joints[jointIndex];
   if (joint.kind == ConnectionKind::Coupling) {
     // value(follower) - multiplier value(leader) - offset, in the follower's unit.
@@ -106,7 +109,8 @@ double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, 
       const auto it = values.find(mechanism.joints[j].name);
       return it == values.end() ? 0.0 : it->second;
     };
-    const double residual = std::abs(value(joint.follower) - joint.multiplier * value(joint.leader) - joint.offset);
+    const double residual =
+        std::abs(value(joint.follower) - joint.multiplier * value(joint.leader) - joint.offset);
     return mechanism.joints[joint.follower].type == JointType::Prismatic ? residual : lengthScale * residual;
   }
   if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
@@ -122,16 +126,23 @@ double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, 
   const double frameError = (f1.linear() - f2.linear()).norm();
   switch (joint.type) {
     case JointType::Revolute:
-    case JointType::Continuous: return offset.norm() + lengthScale * axisError;
-    case JointType::Prismatic: return offset.cross(a1).norm() + lengthScale * frameError;
-    case JointType::Cylindrical: return offset.cross(a1).norm() + lengthScale * axisError;
-    case JointType::Spherical: return offset.norm();
+    case JointType::Continuous:
+      return offset.norm() + lengthScale * axisError;
+    case JointType::Prismatic:
+      return offset.cross(a1).norm() + lengthScale * frameError;
+    case JointType::Cylindrical:
+      return offset.cross(a1).norm() + lengthScale * axisError;
+    case JointType::Spherical:
+      return offset.norm();
     case JointType::Universal:
       return offset.norm() +
              lengthScale * std::abs(a1.dot(f2.linear() * joint.axis2) - joint.axis.dot(joint.axis2));
-    case JointType::Planar: return std::abs(offset.dot(a1)) + lengthScale * axisError;
-    case JointType::Fixed: return offset.norm() + lengthScale * frameError;
-    case JointType::Floating: return 0.0;
+    case JointType::Planar:
+      return std::abs(offset.dot(a1)) + lengthScale * axisError;
+    case JointType::Fixed:
+      return offset.norm() + lengthScale * frameError;
+    case JointType::Floating:
+      return 0.0;
   }
   return 0.0;
 }
