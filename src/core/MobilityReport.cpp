@@ -10,9 +10,12 @@ namespace mobility_analysis {
 
 const char* toString(ElementClass elementClass) {
   switch (elementClass) {
-    case ElementClass::Neutral: return "neutral";
-    case ElementClass::OverConstrainedLoop: return "over_constrained_loop";
-    case ElementClass::Redundant: return "redundant";
+    case ElementClass::Neutral:
+      return "neutral";
+    case ElementClass::OverConstrainedLoop:
+      return "over_constrained_loop";
+    case ElementClass::Redundant:
+      return "redundant";
   }
   return "unknown";
 }
@@ -106,10 +109,18 @@ void appendQuoted(Out& out, const std::string& text) {
       continue;
     }
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char escaped[8];
@@ -208,16 +219,16 @@ void appendSelfStress(Out& out, const SelfStressInfo& s) {
 }
 
 std::string deploymentJson(const DeploymentInfo& d) {
-  std::string out = "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
-                    ", \"target_length\": " + number(d.targetLength) + ", \"final_length\": " +
-                    number(d.finalLength, 12) + ", \"final_dof\": " + std::to_string(d.finalDof) +
-                    ", \"stopped_by\": " + array(d.stoppedBy, quote) + ", \"reason\": " + quote(d.reason) +
-                    ",\n    \"steps\": [";
+  std::string out =
+      "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
+      ", \"target_length\": " + number(d.targetLength) + ", \"final_length\": " + number(d.finalLength, 12) +
+      ", \"final_dof\": " + std::to_string(d.finalDof) + ", \"stopped_by\": " + array(d.stoppedBy, quote) +
+      ", \"reason\": " + quote(d.reason) + ",\n    \"steps\": [";
   for (size_t i = 0; i < d.steps.size(); ++i) {
     const DeploymentStep& step = d.steps[i];
-    out += std::string(i ? ",\n      " : "\n      ") + "{\"active_length\": " + number(step.activeLength, 12) +
-           ", \"dof\": " + std::to_string(step.dof) + ", \"cables\": " + array(step.cables, cableJson) +
-           ", \"joints\": {";
+    out += std::string(i ? ",\n      " : "\n      ") +
+           "{\"active_length\": " + number(step.activeLength, 12) + ", \"dof\": " + std::to_string(step.dof) +
+           ", \"cables\": " + array(step.cables, cableJson) + ", \"joints\": {";
     for (size_t j = 0; j < step.joints.size(); ++j)
       out += (j ? ", " : "") + quote(step.joints[j].name) + ": " + number(step.joints[j].value, 12);
     out += "}}";
@@ -233,9 +244,25 @@ void writeJson(const MobilityReport& r, std::string& text);
 std::string toJson(const MobilityReport& r) {
   // One string, appended to in place (through a buffer, BufferedAppender): the links, joints and positions of
   // a 10^5-link chain are 3 10^5 small objects, each once built apart and copied in.
+  // Room for all of it at once, from the sizes of its parts: grown by doubling from too small a guess, a
+  // report whose listed states are most of it (a 100 x 100 grid of continuous bars: 21 MB, 19 800 states)
+  // was copied three times over and touched 36 MB of fresh pages. The constants are each record's fixed text
+  // with its numbers.
+  size_t size = 4096 + 96 * (r.links.size() + r.joints.size()) + 48 * r.positions.size() +
+                8 * r.nullityTrace.size() + 80 * r.redundantJoints.size() + 4 * r.selfStress.states.size();
+  for (const CableState& c : r.cables)  // {"name": "", "type": "", "state": "", "length": , "distance": }
+    size += 96 + c.name.size();
+  for (const RedundantConstraint& c : r.redundantConstraints)
+    size += 96 + c.source.size() + c.name.size() + c.kind.size() + c.equation.size() + c.cause.size();
+  auto addForces = [&size](const std::vector<ElementForce>& elements) {
+    for (const ElementForce& element : elements)  // {"name": "", "kind": "", "force": } and a number
+      size += 48 + element.name.size() + element.kind.size();
+  };
+  for (const SelfStressState& state : r.selfStress.states)
+    addForces(state.elements);
+  addForces(r.selfStress.prestress);
   std::string text;
-  text.reserve(256 + 96 * (r.links.size() + r.joints.size()) + 48 * r.positions.size() +
-               160 * r.redundantConstraints.size());
+  text.reserve(size + size / 16);  // a margin: a doubling at the very end would copy all of it once more
   writeJson(r, text);
   return text;
 }
@@ -432,7 +459,8 @@ void writeJson(const MobilityReport& r, std::string& text) {
 
 std::string toText(const MobilityReport& r) {
   std::ostringstream out;
-  out << "Mechanism '" << r.robot << "' (" << r.file << "), " << r.mode << " analysis (lambda = " << r.lambda << ")\n";
+  out << "Mechanism '" << r.robot << "' (" << r.file << "), " << r.mode << " analysis (lambda = " << r.lambda
+      << ")\n";
   out << "  degrees of freedom (nullity of the constraint Jacobian): " << r.dof << "\n";
   out << "  Grubler-Kutzbach count:                                  " << r.grublerKutzbachDof << "\n";
   out << "  finite DOF (how it really moves near this pose):          " << r.finiteDof
@@ -442,16 +470,19 @@ std::string toText(const MobilityReport& r) {
   out << "  passive DOF (idle groups) " << r.passiveDof << ", output DOF " << r.outputDof << "\n";
   for (const PassiveMotion& m : r.passiveMotions)
     out << "    passive: " << m.description << "\n";
-  out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints << ", rank "
-      << r.rank << "\n";
+  out << "  natural coordinates " << r.numCoordinates << ", constraint equations " << r.numConstraints
+      << ", rank " << r.rank << "\n";
   out << "  Calladine-Maxwell: m = num_coordinates - rank = " << r.numCoordinates << " - " << r.rank << " = "
-      << r.selfStress.mechanismModes << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints
-      << " - " << r.rank << " = " << r.selfStress.count << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
+      << r.selfStress.mechanismModes
+      << " (mechanism modes = dof), s = num_constraints - rank = " << r.numConstraints << " - " << r.rank
+      << " = " << r.selfStress.count
+      << " (states of self-stress); m - s = " << r.selfStress.mechanismModes - r.selfStress.count
       << " = num_coordinates - num_constraints\n";
   out << "  redundant equations: " << r.numRedundant << " (= dof - Grubler = " << r.dof - r.grublerKutzbachDof
       << ")\n";
   for (const RedundantJoint& j : r.redundantJoints) {
-    out << "    joint " << j.name << ": " << j.redundantEquations << " of " << j.equations << " equations redundant\n";
+    out << "    joint " << j.name << ": " << j.redundantEquations << " of " << j.equations
+        << " equations redundant\n";
   }
   for (const RedundantConstraint& c : r.redundantConstraints) {
     out << "      #" << c.index << " [" << c.source << " " << c.name << ", " << c.kind << "] " << c.equation
@@ -464,21 +495,27 @@ std::string toText(const MobilityReport& r) {
   } else if (r.redundantLinks.empty()) {
     out << "none";
   }
-  for (size_t i = 0; i < r.redundantLinks.size(); ++i) out << (i ? ", " : "") << r.redundantLinks[i];
+  for (size_t i = 0; i < r.redundantLinks.size(); ++i)
+    out << (i ? ", " : "") << r.redundantLinks[i];
   out << "\n  redundant boundary (ground) constraints: ";
-  if (r.redundantBoundaries.empty()) out << "none";
-  for (size_t i = 0; i < r.redundantBoundaries.size(); ++i) out << (i ? ", " : "") << r.redundantBoundaries[i];
+  if (r.redundantBoundaries.empty())
+    out << "none";
+  for (size_t i = 0; i < r.redundantBoundaries.size(); ++i)
+    out << (i ? ", " : "") << r.redundantBoundaries[i];
   out << "\n";
   std::vector<std::string> loop;
   for (const ElementStatus& s : r.links) {
-    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
+    if (s.elementClass == ElementClass::OverConstrainedLoop)
+      loop.push_back(s.name);
   }
   for (const ElementStatus& s : r.joints) {
-    if (s.elementClass == ElementClass::OverConstrainedLoop) loop.push_back(s.name);
+    if (s.elementClass == ElementClass::OverConstrainedLoop)
+      loop.push_back(s.name);
   }
   if (!loop.empty()) {
     out << "  other members of over-constrained loops: ";
-    for (size_t i = 0; i < loop.size(); ++i) out << (i ? ", " : "") << loop[i];
+    for (size_t i = 0; i < loop.size(); ++i)
+      out << (i ? ", " : "") << loop[i];
     out << "\n";
   }
   for (const CableState& c : r.cables) {
@@ -487,28 +524,32 @@ std::string toText(const MobilityReport& r) {
   }
   if (r.deployment) {
     const DeploymentInfo& d = *r.deployment;
-    out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length " << number(d.initialLength, 6)
-        << " m -> " << number(d.finalLength, 9) << " m, final DOF " << d.finalDof << "; " << d.reason << "\n";
+    out << "  deployment by cable " << d.cable << ": " << d.steps.size() << " steps, length "
+        << number(d.initialLength, 6) << " m -> " << number(d.finalLength, 9) << " m, final DOF "
+        << d.finalDof << "; " << d.reason << "\n";
   }
   const SelfStressInfo& s = r.selfStress;
   for (size_t k = 0; k < s.states.size() && k < 20; ++k) {
     out << "    state " << k + 1 << ":";
     for (size_t e = 0; e < s.states[k].elements.size() && e < 12; ++e)
       out << " " << s.states[k].elements[e].name << " " << number(s.states[k].elements[e].force, 3);
-    if (s.states[k].elements.size() > 12) out << " ... (" << s.states[k].elements.size() << " elements)";
+    if (s.states[k].elements.size() > 12)
+      out << " ... (" << s.states[k].elements.size() << " elements)";
     out << "\n";
   }
-  if (s.states.size() > 20 || !s.statesListed) out << "    ... (" << s.count << " states in all)\n";
+  if (s.states.size() > 20 || !s.statesListed)
+    out << "    ... (" << s.count << " states in all)\n";
   if (s.tautCables > 0) {
-    out << "  prestress: " << (s.prestressable ? "prestressable" : "NOT prestressable") << " (" << s.tautCables
-        << " taut cables)";
-    if (s.prestressable) out << ", " << (s.prestressStable ? "prestress-stable" : "not prestress-stable");
+    out << "  prestress: " << (s.prestressable ? "prestressable" : "NOT prestressable") << " ("
+        << s.tautCables << " taut cables)";
+    if (s.prestressable)
+      out << ", " << (s.prestressStable ? "prestress-stable" : "not prestress-stable");
     out << "; " << s.stability << "\n";
   }
   out << "  rank margin: smallest kept pivot " << number(r.rankMargin.smallestKeptPivot, 3)
       << ", largest dropped residual " << number(r.rankMargin.largestDroppedResidual, 3) << " (tolerance "
-      << number(r.rankMargin.tolerance, 3) << ")" << (r.rankMargin.nearTolerance ? "  WARNING: near the tolerance" : "")
-      << "\n";
+      << number(r.rankMargin.tolerance, 3) << ")"
+      << (r.rankMargin.nearTolerance ? "  WARNING: near the tolerance" : "") << "\n";
   out << "  lengths in Lc = " << number(r.characteristicLength, 6) << " m; loop closure residual "
       << number(r.closureResidualBefore, 3) << " m before assembly, " << number(r.closureResidualAfter, 3)
       << " m after\n";
@@ -562,7 +603,8 @@ std::optional<Diagnostic> checkReport(const MobilityReport& r) {
   if (!(r.characteristicLength > 0.0))
     return refuse("characteristic_length is not positive");
   if (r.rank < 0 || r.rank > r.numCoordinates || r.rank > r.numConstraints)
-    return refuse("rank " + std::to_string(r.rank) + " is outside [0, min(num_coordinates, num_constraints)]");
+    return refuse("rank " + std::to_string(r.rank) +
+                  " is outside [0, min(num_coordinates, num_constraints)]");
   if (r.numCoordinates - r.rank != r.dof) {
     return refuse("num_coordinates - rank = " + std::to_string(r.numCoordinates - r.rank) + " but dof is " +
                   std::to_string(r.dof));
