@@ -1,6 +1,7 @@
 #include "mobility_analysis/analysis/CompositeBalls.hpp"
 
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
