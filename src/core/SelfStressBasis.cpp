@@ -487,7 +487,7 @@ class LocalStressFinder {
   std::vector<int> columnOfPriority_;  ///< Inverse of order_.columnPriority where that is a permutation.
   bool inverseTried_ = false;
   SparseJacobian local_;
-  SparseElimination localElimination_;  ///< Reset for each ball (its pools keep their capacity).
+  SparseElimination localElimination_;       ///< Reset for each ball (its pools keep their capacity).
   std::vector<int> spaceRows_, spaceLinks_;  ///< findInSpace's ball: its rows and the links they reach.
   core_detail::LocalMemo<std::optional<SelfStress>> memo_;
   int lastRadius_ = 1;
@@ -496,18 +496,19 @@ class LocalStressFinder {
   bool inSpaceFirst_ = false;
 };
 
-/// When a sweep gives up: past a fixed number of stored entries, or past a multiple of the entries of the
-/// rows it has taken so far (both 0: never).
+/// When an elimination gives up: past a fixed number of stored entries, or past a multiple of the entries of
+/// the rows it has taken so far plus a floor (either 0: not that limit; both: never).
 struct FillBudget {
   size_t entries = 0;
-  size_t perRowEntry = 0;  ///< With kFillFloor added.
+  size_t perRowEntry = 0;
+  size_t floor = kFillFloor;  ///< Added to the multiple.
   static FillBudget none() { return {}; }
   static FillBudget total(size_t entries) { return {entries, 0}; }
   static FillBudget proportional(size_t factor) { return {0, factor}; }
   bool unlimited() const { return entries == 0 && perRowEntry == 0; }
   bool exceeded(size_t stored, size_t rowEntries) const {
     return (entries > 0 && stored > entries) ||
-           (perRowEntry > 0 && stored > perRowEntry * rowEntries + kFillFloor);
+           (perRowEntry > 0 && stored > perRowEntry * rowEntries + floor);
   }
 };
 
@@ -643,11 +644,12 @@ std::optional<StressEchelon> reduceStresses(const std::vector<SelfStress>& stres
   // the square of the rows taken, and the total budget is passed only after most of that square has been
   // paid: at 50 x 50 it stored 20 times the entries of the rows taken after 4 000 of them, and passed the
   // total 1 850 rows later. Where it does not (grids of continuous bars) it stays within 3.3 times.
-  const size_t totalBudget = kEchelonFillFactor * entries + kEchelonFillFloor;
+  const FillBudget budget = limited ? FillBudget{kEchelonFillFactor * entries + kEchelonFillFloor,
+                                                 kEchelonRunningFactor, kEchelonFillFloor}
+                                    : FillBudget::none();
   size_t taken = 0;
   for (int r = m - 1; r >= 0 && elimination.rank() < numStresses; --r) {
-    const size_t stored = elimination.storedEntries();
-    if (limited && (stored > totalBudget || stored > kEchelonRunningFactor * taken + kEchelonFillFloor))
+    if (budget.exceeded(elimination.storedEntries(), taken))
       return std::nullopt;
     reduction.pivot[r] = elimination.addRow(Y, r, 1.0).dependent ? 0 : 1;
     taken += static_cast<size_t>(Y.outerIndexPtr()[r + 1] - Y.outerIndexPtr()[r]);
