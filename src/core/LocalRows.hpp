@@ -1,7 +1,8 @@
 #pragma once
 
 // Private to src/core: the local stress searches (SelfStressBasis.cpp, ContractEchelon.cpp,
-// analysis/Prestress.cpp) copy a few rows of J into a small matrix through it.
+// analysis/Prestress.cpp, RedundantLinks.cpp) copy a few rows of J into a small matrix through it; row norms
+// as J.row(r).norm() sums them.
 
 #include <cassert>
 #include <cmath>
@@ -14,13 +15,12 @@ namespace mobility_analysis {
 namespace core_detail {
 
 /// The norm of row @p r of @p J: the same sum, in the same order, as J.row(r).norm(), without building the
-/// row's block expression (a local search takes it for every row of every ball).
-inline double rowNorm(const SparseJacobian& J, int r) {
-  assert(J.isCompressed());
-  const double* value = J.valuePtr();
+/// row's block expression (a local search takes it for every row of every ball, the passive-freedom search
+/// for every row of J).
+inline double rowNorm(const SparseJacobian& J, Eigen::Index r) {
   double squared = 0.0;
-  for (int i = J.outerIndexPtr()[r]; i < J.outerIndexPtr()[r + 1]; ++i)
-    squared += value[i] * value[i];
+  for (SparseJacobian::InnerIterator it(J, r); it; ++it)
+    squared += it.value() * it.value();
   return std::sqrt(squared);
 }
 

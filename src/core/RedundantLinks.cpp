@@ -1,7 +1,6 @@
 #include "mobility_analysis/RedundantLinks.hpp"
 
 #include <algorithm>
-#include <numeric>
 
 #include "Buckets.hpp"
 #include "LocalRows.hpp"
@@ -21,9 +20,9 @@ core_detail::Buckets connectionRowsOfLinks(const Mechanism& mechanism, const Coo
       if (eq.source != EquationSource::Joint)
         continue;
       const Joint& joint = mechanism.joints[eq.element];
-      for (int link : {joint.link1, joint.link2}) {
-        if (link == joint.link2 && joint.link2 == joint.link1)
-          continue;
+      const int ends = joint.link2 != joint.link1 ? 2 : 1;  // a link joined to itself lists the row once
+      for (int end = 0; end < ends; ++end) {
+        const int link = end == 0 ? joint.link1 : joint.link2;
         if (pass == 0)
           rowsOfLink.count(link);
         else
@@ -54,6 +53,7 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
   // Reused from link to link.
   std::vector<int> columnOf(stresses.size(), -1), columns, rows;
   SparseJacobian Yl;
+  SparseElimination elimination(0, {}, tolerance, false);
   for (int l = 0; l < numLinks; ++l) {
     const core_detail::BucketRange linkRows = rowsOfLink[l];
     const int k = static_cast<int>(linkRows.size());
@@ -79,9 +79,9 @@ std::vector<bool> findRedundantLinks(const Mechanism& mechanism, const Coordinat
       std::stable_sort(rows.begin(), rows.end(), [&](int a, int b) { return stressesAt(a) < stressesAt(b); });
       core_detail::copyRows(
           Y, rows, [&](int column) { return columnOf[column]; }, numColumns, Yl);
-      SparseElimination elimination(numColumns, {}, tolerance, false);
+      elimination.reset(numColumns);
       for (int i = 0; i < k && elimination.rank() < numColumns; ++i) {
-        const double norm = Yl.row(i).norm();
+        const double norm = core_detail::rowNorm(Yl, i);
         elimination.addRow(Yl, i, norm > 0.0 ? 1.0 / norm : 0.0);
       }
       redundant[l] = elimination.rank() == needed;

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "../Buckets.hpp"
+#include "../LocalRows.hpp"
 #include "mobility_analysis/coordinates/EquationForms.hpp"
 
 namespace mobility_analysis {
@@ -178,14 +179,9 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
     connections_.add(jointEnds[j].first, static_cast<int>(j));
     connections_.add(jointEnds[j].second, static_cast<int>(j));
   }
-  // Each row's norm once (a row is in up to 3 kMaxGroup groups): the squares summed in the row's order from
-  // 0, as J.row(r).norm() sums them, without its generic sparse iterators.
-  for (Eigen::Index r = 0; r < J.rows(); ++r) {
-    double squares = 0.0;
-    for (SparseJacobian::InnerIterator it(J, r); it; ++it)
-      squares += it.value() * it.value();
-    rowNorm[static_cast<size_t>(r)] = std::sqrt(squares);
-  }
+  // Each row's norm once (a row is in up to 3 kMaxGroup groups).
+  for (Eigen::Index r = 0; r < J.rows(); ++r)
+    rowNorm[static_cast<size_t>(r)] = core_detail::rowNorm(J, r);
 }
 
 Eigen::Vector3d SearchContext::element3(int e) const {
@@ -623,7 +619,7 @@ bool GroupSearch::boundsClearNullity() const {
   }
   const double bound = 100.0 * kTwistNullity * std::max(std::sqrt(frobenius2), 1.0);
   return context_.planar ? clearlyFullRank<3>(gram.topLeftCorner<3, 3>().eval(), bound)
-                          : clearlyFullRank<6>(gram, bound);
+                         : clearlyFullRank<6>(gram, bound);
 }
 
 Eigen::MatrixXd GroupSearch::buildT() const {
