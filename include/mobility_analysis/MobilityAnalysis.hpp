@@ -25,6 +25,10 @@ struct AnalysisOptions {
   /// Analyse every active cable as locked: a taut cable of the length it has at the assembled pose (the
   /// deployed mast with its actuator locked), instead of ignoring it as the driver.
   bool lockActiveCables = false;
+  /// Large models (from 2 10^4 equations) run the passive-freedom search and the self-stress report on a second
+  /// thread beside the phases they do not feed; false keeps the whole analysis on the caller's thread. The
+  /// answer is the same to the bit either way.
+  bool sideThreads = true;
   /// Called with a phase name and a fraction in [0, 1] during long analyses; may be empty.
   std::function<void(const std::string&, double)> progress;
 };

@@ -15,6 +15,8 @@
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
 #include "mobility_analysis/analysis/SelfStressReport.hpp"
 
+#include "SideTask.hpp"
+
 namespace mobility_analysis {
 
 int computeGrublerKutzbach(const Mechanism& mechanism, const CoordinateModel& model) {
@@ -55,6 +57,11 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
 }
 
 namespace {
+
+/// From this many equations on, the passive-freedom search and the self-stress report run on a second thread
+/// beside the phases they do not depend on (core_detail::SideTask): about a millisecond of work, against tens
+/// of microseconds to start a thread.
+constexpr Eigen::Index kSideTaskEquations = 20000;
 
 /**
  * Idle groups' motions (Tsai): a rod spinning between two balls, a link sliding between parallel slides.
@@ -103,12 +110,20 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   progress("jacobian", 0.2);
   const SparseJacobian J = computeConstraintJacobian(model, analysis.assembled.q);
   const double tolerance = options.rankTolerance > 0.0 ? options.rankTolerance : tolerances::kRank;
+  // The passive-freedom search reads the Jacobian and the pose only, and the self-stress report the basis
+  // besides: on a large model each runs beside the phases that do not feed it (on a braced lattice the report
+  // and the redundant links take about as long; on a chain the search and the self-stresses).
+  const bool sideTasks = options.sideThreads && J.rows() >= kSideTaskEquations;
+  core_detail::SideTask passiveTask(sideTasks,
+                                    [&] { return findIdleMotions(mechanism, analysis.assembled, J); });
   // One elimination in sweep order finds a local basis of the self-stresses; the ordered answer, the loops
   // and the redundant links are all read off it (SelfStressBasis.hpp, RedundantLinks.hpp).
   progress("self-stresses", 0.3);
   const SelfStressBasis basis = computeSelfStressBasis(mechanism, model, J, tolerance, [&](double fraction) {
     progress("self-stresses", 0.3 + 0.5 * fraction);
   });
+  core_detail::SideTask stressReportTask(
+      sideTasks, [&] { return computeSelfStressInfo(mechanism, model, analysis.assembled.q, J, basis); });
   progress("ordered redundancy", 0.8);
   // When the basis is numerically ambiguous, the lecture's test itself in contract order decides (strict
   // partial pivoting, near-tolerance rows re-checked by their orthogonal distance: RedundancyAnalysis.hpp).
@@ -135,7 +150,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   report.finiteDof = finite.finiteDof;
   report.singular = finite.singular;
   progress("passive freedoms", 0.87);
-  const PassiveFreedoms passive = findIdleMotions(mechanism, analysis.assembled, J);
+  const PassiveFreedoms passive = passiveTask.get();
   report.passiveDof = std::min(passive.dof, report.finiteDof);
   report.passiveMotions = passive.motions;
   report.outputDof = report.finiteDof - report.passiveDof;
@@ -256,7 +271,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
     }
   }
   progress("self-stress report", 0.95);
-  report.selfStress = computeSelfStressInfo(mechanism, model, analysis.assembled.q, J, basis);
+  report.selfStress = stressReportTask.get();
   progress("done", 1.0);
   return analysis;
 }
