@@ -84,10 +84,13 @@ using ProgressCallback = std::function<void(double)>;
  * @param[in] fillBudget entries the sweep from the ground may store before it is abandoned for the
  * leaves-first order (0: 8 times the entries of the rows it has taken so far, plus 10^6; tests pass 1 to take
  * the leaves-first order).
+ * @param[in] sideThread whether a large model's local stresses may be found ahead on a second thread while
+ * the sweep eliminates; the basis is the same to the bit either way.
  */
 SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
                                        const SparseJacobian& J, double tolerance,
-                                       const ProgressCallback& progress = {}, size_t fillBudget = 0);
+                                       const ProgressCallback& progress = {}, size_t fillBudget = 0,
+                                       bool sideThread = false);
 
 /**
  * @brief The lecture's ordered rank test read off a self-stress basis, without eliminating in contract order.

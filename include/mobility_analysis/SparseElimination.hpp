@@ -65,7 +65,14 @@ class SparseElimination {
    * found, without keeping anything. keep() then keeps it as a pivot row, whatever step.dependent said; the
    * next reduce or addRow forgets it.
    */
-  Step reduce(const SparseJacobian& J, int r, double scale);
+  Step reduce(const SparseJacobian& J, int r, double scale) { return reduceOver(J, r, scale, rank()); }
+  /**
+   * @brief reduce() against the first @p numPivots pivot rows only: the reduction, and multipliers(), that
+   * row @p r had when it was added with that many pivot rows kept, to the bit (pivot rows never change once
+   * kept, and a reduction reads no other). The sweep traces a dependent row's stress after the elimination
+   * has gone past it (FindsAhead.hpp). keep() must not follow.
+   */
+  Step reduceOver(const SparseJacobian& J, int r, double scale, int numPivots);
   /// Keeps the row reduce() last reduced as a pivot row (its reduced norm must be positive).
   void keep();
   /// Room for @p rows pivot rows holding @p entries entries in all (a hint: the storage still grows).

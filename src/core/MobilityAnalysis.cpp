@@ -119,9 +119,9 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   // One elimination in sweep order finds a local basis of the self-stresses; the ordered answer, the loops
   // and the redundant links are all read off it (SelfStressBasis.hpp, RedundantLinks.hpp).
   progress("self-stresses", 0.3);
-  const SelfStressBasis basis = computeSelfStressBasis(mechanism, model, J, tolerance, [&](double fraction) {
-    progress("self-stresses", 0.3 + 0.5 * fraction);
-  });
+  const SelfStressBasis basis = computeSelfStressBasis(
+      mechanism, model, J, tolerance, [&](double fraction) { progress("self-stresses", 0.3 + 0.5 * fraction); },
+      0, sideTasks);
   core_detail::SideTask stressReportTask(
       sideTasks, [&] { return computeSelfStressInfo(mechanism, model, analysis.assembled.q, J, basis); });
   progress("ordered redundancy", 0.8);

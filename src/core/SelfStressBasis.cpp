@@ -7,27 +7,16 @@
 #include <numeric>
 #include <unordered_map>
 
-#include "EquationGraph.hpp"
-#include "LocalMemo.hpp"
-#include "LocalRows.hpp"
+#include "FindsAhead.hpp"
+#include "LocalStressFinder.hpp"
 #include "StressMatrix.hpp"
 
 namespace mobility_analysis {
 
 namespace {
 
-/// A traced stress with more equations than this is probably running down a chain of loops (a loop of four
-/// spatial links has about 70); it is found again by a local elimination instead [equations].
-constexpr size_t kTraceLimit = 160;
-
-/// The local elimination gives up on balls with more equations than this; the stress is then traced in full,
-/// as it really is global (a ring's) [equations].
-constexpr size_t kLocalLimit = 6000;
-
-/// The ball in space starts at this many times the typical spacing of the places where equations act, and
-/// grows by kSpaceGrowth each time it holds no stress for its row.
-constexpr double kSpaceStart = 2.0;
-constexpr double kSpaceGrowth = 1.5;
+using core_detail::kTraceLimit;
+using core_detail::LocalStressFinder;
 
 /// Local searches that may fail in a row before the basis stops searching locally (see futileFinds).
 constexpr int kFutileFinds = 8;
@@ -46,455 +35,12 @@ constexpr size_t kEchelonFillFactor = 2;
 constexpr size_t kEchelonRunningFactor = 8;
 constexpr size_t kEchelonFillFloor = 100000;
 
+/// From this many equations on, a sweep allowed a second thread has its local finds made ahead on it
+/// (FindsAhead.hpp): a thread costs tens of microseconds.
+constexpr Eigen::Index kFindAheadEquations = 20000;
+
 /// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
 constexpr double kStressNoise = 1e-10;
-
-/**
- * Where each equation acts, at the pose the model was built at: a joint's equations at the points they
- * join, a point's rigid-link combination at the point. The rest of a link's equations (those between its
- * basis elements, its boundary) act on the link as a whole and are attached to it.
- *
- * Why in space: on a link through many joints (a continuous bar pinned at every crossing of a grid) every
- * joint's equations reach every other's through the link's basis, so a ball of links is the whole mechanism
- * after one step, while the self-stresses stay among a few neighbouring joints; their neighbourhood along the
- * link is only visible in where they are.
- */
-class EquationPlaces {
- public:
-  EquationPlaces(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J)
-      : place_(J.rows(), Eigen::Vector3d::Zero()), located_(J.rows(), 0), attached_(mechanism.links.size()) {
-    std::vector<int> elementOf(J.cols(), -1);
-    for (size_t e = 0; e < model.elements.size(); ++e) {
-      for (int i = 0; i < model.dim; ++i)
-        elementOf[model.elements[e].offset + i] = static_cast<int>(e);
-    }
-    auto position = [&](int e) {
-      Eigen::Vector3d x = Eigen::Vector3d::Zero();
-      x.head(model.dim) = model.q0.segment(model.elements[e].offset, model.dim);
-      return x;
-    };
-    std::vector<int> seen;
-    for (int r = 0; r < J.rows(); ++r) {
-      const ConstraintEquation& eq = model.equations[r];
-      if (eq.source == EquationSource::Joint) {
-        // The mean of the points it touches (each point once).
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        int count = 0;
-        seen.clear();
-        for (SparseJacobian::InnerIterator it(J, r); it; ++it) {
-          const int e = elementOf[it.col()];
-          if (e < 0 || !model.elements[e].isPoint || std::find(seen.begin(), seen.end(), e) != seen.end())
-            continue;
-          seen.push_back(e);
-          sum += position(e);
-          ++count;
-        }
-        if (count > 0) {
-          place_[r] = sum / count;
-          located_[r] = 1;
-        }
-      } else if (eq.source == EquationSource::Link && eq.form == EquationForm::Combination &&
-                 model.elements[eq.target].isPoint) {
-        place_[r] = position(eq.target);
-        located_[r] = 1;
-      } else {
-        attached_[eq.element].push_back(r);
-      }
-    }
-    // The typical spacing: on each link with located equations, its extent over the places it has less one.
-    std::vector<std::vector<int>> linkPlaces(mechanism.links.size());
-    for (int r = 0; r < J.rows(); ++r) {
-      if (located_[r] != 0 && model.equations[r].source == EquationSource::Link)
-        linkPlaces[model.equations[r].element].push_back(r);
-    }
-    std::vector<double> spacings;
-    for (const std::vector<int>& rows : linkPlaces) {
-      if (rows.size() < 2)
-        continue;
-      Eigen::Vector3d low = place_[rows[0]], high = low;
-      for (int r : rows) {
-        low = low.cwiseMin(place_[r]);
-        high = high.cwiseMax(place_[r]);
-      }
-      const double extent = (high - low).norm();
-      if (extent > 0.0)
-        spacings.push_back(extent / static_cast<double>(rows.size() - 1));
-    }
-    if (!spacings.empty()) {
-      std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
-      spacing_ = spacings[spacings.size() / 2];
-    } else {
-      spacing_ = model.characteristicLength > 0.0 ? model.characteristicLength : 1.0;
-    }
-    // Located rows bucketed in cubes of the spacing.
-    for (int r = 0; r < J.rows(); ++r) {
-      if (located_[r] == 0)
-        continue;
-      const Eigen::Vector3i cell = cellOf(place_[r]);
-      lowest_ = numLocated_ == 0 ? cell : lowest_.cwiseMin(cell);
-      highest_ = numLocated_ == 0 ? cell : highest_.cwiseMax(cell);
-      cells_[key(cell)].push_back(r);
-      ++numLocated_;
-    }
-  }
-
-  bool located(int row) const { return located_[row] != 0; }
-  size_t numLocated() const { return numLocated_; }
-  const Eigen::Vector3d& place(int row) const { return place_[row]; }
-  double spacing() const { return spacing_; }
-  /// Rows without a place, acting on @p link as a whole.
-  const std::vector<int>& attached(int link) const { return attached_[link]; }
-
-  /// Calls @p visit for every located row within @p radius of @p center.
-  template <class Visit>
-  void forEachWithin(const Eigen::Vector3d& center, double radius, Visit&& visit) const {
-    // Only the cells within the places' bounds (a planar model is one cell thick).
-    const Eigen::Vector3i low = cellOf(center - Eigen::Vector3d::Constant(radius)).cwiseMax(lowest_);
-    const Eigen::Vector3i high = cellOf(center + Eigen::Vector3d::Constant(radius)).cwiseMin(highest_);
-    // A box with more cells than there are occupied ones (a wide ball over a ring, whose box is mostly empty:
-    // (ring radius / spacing)^2 cells, quadratic in the ring's length) is read by its occupied cells instead.
-    const Eigen::Vector3d extent = (high - low + Eigen::Vector3i::Ones()).cast<double>();
-    if (extent.x() * extent.y() * extent.z() > static_cast<double>(cells_.size())) {
-      for (const auto& cell : cells_) {
-        for (int r : cell.second) {
-          if ((place_[r] - center).squaredNorm() <= radius * radius)
-            visit(r);
-        }
-      }
-      return;
-    }
-    for (int x = low.x(); x <= high.x(); ++x) {
-      for (int y = low.y(); y <= high.y(); ++y) {
-        for (int z = low.z(); z <= high.z(); ++z) {
-          const auto cell = cells_.find(key(Eigen::Vector3i(x, y, z)));
-          if (cell == cells_.end())
-            continue;
-          for (int r : cell->second) {
-            if ((place_[r] - center).squaredNorm() <= radius * radius)
-              visit(r);
-          }
-        }
-      }
-    }
-  }
-
- private:
-  Eigen::Vector3i cellOf(const Eigen::Vector3d& x) const {
-    return (x / spacing_).array().floor().cast<int>();
-  }
-  static uint64_t key(const Eigen::Vector3i& cell) {
-    auto part = [](int v) { return static_cast<uint64_t>(static_cast<uint32_t>(v) & 0x1fffffu); };
-    return part(cell.x()) | part(cell.y()) << 21 | part(cell.z()) << 42;
-  }
-
-  std::vector<Eigen::Vector3d> place_;
-  std::vector<char> located_;
-  std::vector<std::vector<int>> attached_;
-  double spacing_ = 1.0;
-  size_t numLocated_ = 0;
-  Eigen::Vector3i lowest_ = Eigen::Vector3i::Zero(), highest_ = Eigen::Vector3i::Zero();
-  std::unordered_map<uint64_t, std::vector<int>> cells_;
-};
-
-/**
- * Finds a stress whose last equation (in sweep order) is a given row among the links within a growing radius
- * of the row's links: the sweep's elimination restricted to the rows of that ball. Workspaces are kept across
- * calls, so one call costs what its ball holds, not what the mechanism holds. Where a ball of links is the
- * whole mechanism at once (links through many joints), the ball is taken in space instead (EquationPlaces).
- */
-class LocalStressFinder {
- public:
-  LocalStressFinder(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J,
-                    const EliminationOrder& order, const std::vector<int>& position, double tolerance)
-      : mechanism_(mechanism),
-        model_(model),
-        J_(J),
-        order_(order),
-        position_(position),
-        tolerance_(tolerance),
-        graph_(mechanism, model),
-        inBall_(mechanism.links.size(), 0),
-        jointTaken_(mechanism.joints.size(), 0),
-        columnMap_(J.cols(), -1),
-        localElimination_(0, {}, tolerance, true) {}
-
-  /// Whether the ball in space is tried first (it found shorter stresses than the links' ball).
-  bool inSpaceFirst() const { return inSpaceFirst_; }
-
-  /// @return The stress, or nothing when the ball grows past kLocalLimit equations first.
-  std::optional<SelfStress> find(int row) {
-    // Once the ball in space has found a shorter stress than the links' ball, the links' is not tried first
-    // again: on a grid of continuous bars it is the whole mechanism for every row.
-    if (inSpaceFirst_) {
-      if (std::optional<SelfStress> found = findInSpace(row))
-        return found;
-      return findAmongLinks(row);
-    }
-    std::optional<SelfStress> amongLinks = findAmongLinks(row);
-    if (amongLinks && amongLinks->size() <= kTraceLimit)
-      return amongLinks;
-    // Failed, or as long as a trace: the ball of links was most of the mechanism.
-    std::optional<SelfStress> inSpace = findInSpace(row);
-    if (inSpace && (!amongLinks || inSpace->size() < amongLinks->size())) {
-      inSpaceFirst_ = true;
-      return inSpace;
-    }
-    return amongLinks;
-  }
-
- private:
-  /// The ball of links around the row's links.
-  std::optional<SelfStress> findAmongLinks(int row) {
-    const ConstraintEquation& eq = model_.equations[row];
-    ball_.clear();
-    if (eq.source == EquationSource::Joint) {
-      include(mechanism_.joints[eq.element].link1);
-      include(mechanism_.joints[eq.element].link2);
-    } else {
-      include(eq.element);
-    }
-    // Start at the radius that sufficed last time: in a regular structure every stress needs the same one.
-    std::optional<SelfStress> found;
-    size_t frontBegin = 0;
-    for (int radius = lastRadius_, reached = 0; !found; radius = radius < 4 ? radius + 1 : 2 * radius) {
-      for (; reached < radius && frontBegin < ball_.size(); ++reached) {
-        const size_t frontEnd = ball_.size();
-        for (size_t i = frontBegin; i < frontEnd; ++i) {
-          for (int j : graph_.incident[ball_[i]]) {
-            include(mechanism_.joints[j].link1);
-            include(mechanism_.joints[j].link2);
-          }
-        }
-        frontBegin = frontEnd;
-      }
-      const std::vector<int>& rows = collectRows(row);
-      if (rows.size() > kLocalLimit) {
-        break;
-      }
-      found = eliminate(rows);
-      if (found) {
-        lastRadius_ = std::min(radius, 4);  // a ring's global stress must not make every later search global
-      } else if (frontBegin == ball_.size()) {
-        break;  // the whole component
-      }
-    }
-    for (int link : ball_)
-      inBall_[link] = 0;
-    return found;
-  }
-
-  /// The ball in space around the row's place: the located rows within a growing radius, and the attached
-  /// rows of every link they reach.
-  std::optional<SelfStress> findInSpace(int row) {
-    if (!places_)
-      places_.emplace(mechanism_, model_, J_);
-    if (!places_->located(row))
-      return std::nullopt;
-    const Eigen::Vector3d center = places_->place(row);
-    std::vector<int>& rows = spaceRows_;
-    std::vector<int>& links = spaceLinks_;
-    const double start = kSpaceStart * places_->spacing();
-    for (double radius = spaceRadius_ > 0.0 ? spaceRadius_ : start;; radius *= kSpaceGrowth) {
-      rows.clear();
-      links.clear();
-      size_t within = 0;
-      auto touch = [&](int link) {
-        if (inBall_[link] == 0) {
-          inBall_[link] = 1;
-          links.push_back(link);
-        }
-      };
-      places_->forEachWithin(center, radius, [&](int r) {
-        ++within;
-        if (position_[r] > position_[row])
-          return;
-        rows.push_back(r);
-        const ConstraintEquation& eq = model_.equations[r];
-        if (eq.source == EquationSource::Joint) {
-          touch(mechanism_.joints[eq.element].link1);
-          touch(mechanism_.joints[eq.element].link2);
-        } else {
-          touch(eq.element);
-        }
-      });
-      for (int link : links) {
-        inBall_[link] = 0;
-        for (int r : places_->attached(link)) {
-          if (position_[r] < position_[row])
-            rows.push_back(r);
-        }
-      }
-      if (rows.size() > kLocalLimit)
-        return std::nullopt;
-      sortBySweep(rows);
-      if (std::optional<SelfStress> found = eliminate(rows)) {
-        // The next row starts where this one succeeded (a regular structure needs the same radius), but a
-        // global stress must not make every later ball global.
-        spaceRadius_ = std::min(radius, 4.0 * start);
-        return found;
-      }
-      if (within == places_->numLocated())
-        return std::nullopt;  // the whole mechanism
-    }
-  }
-
-  void include(int link) {
-    if (inBall_[link] == 0) {
-      inBall_[link] = 1;
-      ball_.push_back(link);
-    }
-  }
-
-  /// The ball's rows up to @p row, in sweep order (in a list kept from call to call).
-  const std::vector<int>& collectRows(int row) {
-    std::vector<int>& rows = ballRows_;
-    rows.clear();
-    joints_.clear();
-    for (int link : ball_) {
-      for (int r : graph_.linkRows[link]) {
-        if (position_[r] < position_[row])
-          rows.push_back(r);
-      }
-      for (int j : graph_.incident[link]) {
-        const Joint& joint = mechanism_.joints[j];
-        if (jointTaken_[j] != 0 || inBall_[joint.link1] == 0 || inBall_[joint.link2] == 0)
-          continue;
-        jointTaken_[j] = 1;
-        joints_.push_back(j);
-        for (int r : graph_.jointRows[j]) {
-          if (position_[r] <= position_[row])
-            rows.push_back(r);
-        }
-      }
-    }
-    for (int j : joints_)
-      jointTaken_[j] = 0;
-    sortBySweep(rows);
-    return rows;
-  }
-
-  /// @p rows in sweep order. Their positions are sorted and read back through the order (every row is in it
-  /// once): the same order as sorting the rows by position, without the indirection in every comparison.
-  void sortBySweep(std::vector<int>& rows) const {
-    for (int& r : rows)
-      r = position_[r];
-    std::sort(rows.begin(), rows.end());
-    for (int& r : rows)
-      r = order_.rows[static_cast<size_t>(r)];
-  }
-
-  /// The elimination of @p rows (the last one the row in question): its dependency, if it is dependent.
-  std::optional<SelfStress> eliminate(const std::vector<int>& rows) {
-    // The columns the rows touch, by sweep priority.
-    std::vector<int>& columns = columns_;
-    columns.clear();
-    for (int r : rows) {
-      for (SparseJacobian::InnerIterator it(J_, r); it; ++it) {
-        if (columnMap_[it.col()] < 0) {
-          columnMap_[it.col()] = 0;
-          columns.push_back(static_cast<int>(it.col()));
-        }
-      }
-    }
-    if (!inverseTried_) {
-      buildColumnOfPriority();
-      inverseTried_ = true;
-    }
-    if (!columnOfPriority_.empty()) {
-      for (int& c : columns)
-        c = order_.columnPriority[c];
-      std::sort(columns.begin(), columns.end());
-      for (int& c : columns)
-        c = columnOfPriority_[static_cast<size_t>(c)];
-    } else {
-      std::sort(columns.begin(), columns.end(),
-                [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
-    }
-    for (size_t c = 0; c < columns.size(); ++c)
-      columnMap_[columns[c]] = static_cast<int>(c);
-    SparseJacobian& local = local_;
-    core_detail::copyRows(
-        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local);
-    for (int c : columns)
-      columnMap_[c] = -1;
-
-    // The same local problem elsewhere (a regular structure) has the same dependency to the bit
-    // (LocalMemo): the elimination reads the local matrix and nothing else.
-    std::optional<SelfStress> stress;
-    const bool keyed = memo_.active();
-    const std::optional<SelfStress>* known = nullptr;
-    if (keyed) {
-      memo_.clearKey();
-      memo_.appendKey(local);
-      known = memo_.find();
-    }
-    if (known) {
-      stress = *known;
-    } else {
-      stress = lastDependency(local);
-      if (keyed)
-        memo_.insert(stress, sizeof(stress) + (stress ? stress->size() * sizeof(SelfStress::value_type) : 0));
-    }
-    if (!stress)
-      return std::nullopt;
-    for (auto& entry : *stress)
-      entry.first = rows[entry.first];
-    std::sort(stress->begin(), stress->end());
-    return stress;
-  }
-
-  /// Where the priorities are a permutation (the sweep numbers every coordinate once), a ball's columns are
-  /// put in priority order by sorting their priorities and reading the columns back: the same order as
-  /// sorting the columns by priority, without the indirection. Built at the first ball only.
-  void buildColumnOfPriority() {
-    std::vector<int> columnOf(order_.columnPriority.size(), -1);
-    for (size_t c = 0; c < order_.columnPriority.size(); ++c) {
-      const int p = order_.columnPriority[c];
-      if (p < 0 || p >= static_cast<int>(columnOf.size()) || columnOf[static_cast<size_t>(p)] >= 0)
-        return;  // not a permutation: the indirect sort
-      columnOf[static_cast<size_t>(p)] = static_cast<int>(c);
-    }
-    columnOfPriority_ = std::move(columnOf);
-  }
-
-  /// The dependency of @p local's last row on the rows before it (local row numbers), if it is dependent.
-  std::optional<SelfStress> lastDependency(const SparseJacobian& local) {
-    // Columns are sorted by sweep priority, so the local column index is the priority.
-    SparseElimination& elimination = localElimination_;
-    elimination.reset(static_cast<int>(local.cols()));
-    SparseElimination::Step step;
-    for (int i = 0; i < local.rows(); ++i) {
-      const double norm = core_detail::rowNorm(local, i);
-      step = elimination.addRow(local, i, norm > 0.0 ? 1.0 / norm : 0.0);
-    }
-    if (!step.dependent)
-      return std::nullopt;
-    return elimination.traceDependency(static_cast<int>(local.rows()) - 1, elimination.multipliers());
-  }
-
-  const Mechanism& mechanism_;
-  const CoordinateModel& model_;
-  const SparseJacobian& J_;
-  const EliminationOrder& order_;
-  const std::vector<int>& position_;
-  double tolerance_;
-  core_detail::EquationGraph graph_;
-  std::vector<int> ball_;
-  std::vector<char> inBall_, jointTaken_;
-  std::vector<int> columnMap_;
-  // Kept from call to call (a braced lattice asks for one ball per redundant row): no allocation once warm.
-  std::vector<int> ballRows_, joints_, columns_;
-  std::vector<int> columnOfPriority_;  ///< Inverse of order_.columnPriority where that is a permutation.
-  bool inverseTried_ = false;
-  SparseJacobian local_;
-  SparseElimination localElimination_;       ///< Reset for each ball (its pools keep their capacity).
-  std::vector<int> spaceRows_, spaceLinks_;  ///< findInSpace's ball: its rows and the links they reach.
-  core_detail::LocalMemo<std::optional<SelfStress>> memo_;
-  int lastRadius_ = 1;
-  std::optional<EquationPlaces> places_;  ///< Built the first time a ball in space is needed.
-  double spaceRadius_ = 0.0;
-  bool inSpaceFirst_ = false;
-};
 
 /// When an elimination gives up: past a fixed number of stored entries, or past a multiple of the entries of
 /// the rows it has taken so far plus a floor (either 0: not that limit; both: never).
@@ -518,7 +64,7 @@ struct FillBudget {
  */
 std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const CoordinateModel& model,
                                           const SparseJacobian& J, const EliminationOrder& order,
-                                          double tolerance, FillBudget fillBudget,
+                                          double tolerance, FillBudget fillBudget, bool findAhead,
                                           const ProgressCallback& progress) {
   const int m = static_cast<int>(J.rows());
   const int n = static_cast<int>(J.cols());
@@ -551,6 +97,45 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
   // 80% of the whole report's time) the search stops after kFutileFinds failures in a row. One global stress
   // among local ones (a ring's) fails once and leaves the search on.
   int futileFinds = 0;
+  // The rule for a dependent row's stress, whoever finds and traces: find a local stress (LocalStressFinder),
+  // cappedTrace the dependency traced up to a limit, fullTrace traced whatever its length.
+  auto resolve = [&](auto&& find, auto&& cappedTrace, auto&& fullTrace) {
+    // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
+    // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
+    std::optional<SelfStress> stress;
+    if (finder().inSpaceFirst() && futileFinds < kFutileFinds) {
+      stress = find();
+      if (stress)
+        ++basis.locallyResolved;
+      else
+        ++futileFinds;
+    }
+    if (!stress)
+      stress = cappedTrace(traceLimit);
+    if (!stress && futileFinds < kFutileFinds) {
+      stress = find();
+      if (stress) {
+        ++basis.locallyResolved;
+        traceLimit = std::max(traceLimit, 2 * stress->size());
+        futileFinds = 0;
+      } else {
+        ++futileFinds;
+      }
+    }
+    if (!stress)
+      stress = fullTrace();
+    return std::move(*stress);
+  };
+  // Finds made ahead on a second thread (FindsAhead.hpp), and what the rule needs of each dependent row once
+  // the elimination has gone past it: how many pivot rows it met, and the capped trace made at once.
+  std::optional<core_detail::FindsAhead> ahead;
+  struct Passed {
+    int row;
+    int pivots;
+    size_t limit;  // of the trace made at once; 0: none made
+    std::optional<SelfStress> trace;
+  };
+  std::vector<Passed> passed;
   const size_t progressStep = std::max<size_t>(1, order.rows.size() / 20);
   size_t rowEntries = 0;  // of the rows taken so far
   for (size_t i = 0; i < order.rows.size(); ++i) {
@@ -565,31 +150,64 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
     if (!elimination.addRow(J, r, norm > 0.0 ? 1.0 / norm : 0.0).dependent) {
       continue;
     }
-    // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
-    // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
-    std::optional<SelfStress> stress;
-    if (finder().inSpaceFirst() && futileFinds < kFutileFinds) {
-      stress = finder().find(r);
-      if (stress)
-        ++basis.locallyResolved;
-      else
-        ++futileFinds;
-    }
-    if (!stress)
-      stress = elimination.traceDependency(r, elimination.multipliers(), traceLimit);
-    if (!stress && futileFinds < kFutileFinds) {
-      stress = finder().find(r);
-      if (stress) {
-        ++basis.locallyResolved;
-        traceLimit = std::max(traceLimit, 2 * stress->size());
-        futileFinds = 0;
-      } else {
-        ++futileFinds;
+    if (findAhead) {
+      if (!ahead)
+        ahead.emplace(mechanism, model, J, order, position, tolerance, kFutileFinds, static_cast<size_t>(m));
+      Passed row{r, elimination.rank(), 0, std::nullopt};
+      if (!ahead->predictsSpaceFirst()) {
+        row.limit = ahead->traceLimitHint(traceLimit);
+        row.trace = elimination.traceDependency(r, elimination.multipliers(), row.limit);
       }
+      ahead->publish(r, row.trace.has_value());
+      passed.push_back(std::move(row));
+      continue;
     }
-    if (!stress)
-      stress = elimination.traceDependency(r, elimination.multipliers());
-    basis.stresses.push_back(std::move(*stress));
+    auto find = [&] { return finder().find(r); };
+    auto cappedTrace = [&](size_t limit) {
+      return elimination.traceDependency(r, elimination.multipliers(), limit);
+    };
+    auto fullTrace = [&] { return elimination.traceDependency(r, elimination.multipliers()); };
+    basis.stresses.push_back(resolve(find, cappedTrace, fullTrace));
+  }
+  if (ahead) {
+    // The rule row by row, as on one thread: a find made ahead from the state the finder is in, else the
+    // finder's own; the trace made at once if its limit is the rule's, else traced again from the
+    // reduction the row had when it was added.
+    ahead->finish(finder());
+    finder().setState(LocalStressFinder::State{});
+    for (size_t k = 0; k < passed.size(); ++k) {
+      Passed& row = passed[k];
+      core_detail::FindsAhead::Find* made = ahead->finds(k);
+      auto find = [&]() -> std::optional<SelfStress> {
+        for (int f = 0; f < 2; ++f) {
+          if (made[f].made && made[f].from == finder().state()) {
+            made[f].made = false;
+            finder().setState(made[f].after);
+            return std::move(made[f].stress);
+          }
+        }
+        return finder().find(row.row);
+      };
+      bool reduced = false;
+      auto reduceAgain = [&] {
+        if (reduced)
+          return;
+        const double norm = J.row(row.row).norm();
+        elimination.reduceOver(J, row.row, norm > 0.0 ? 1.0 / norm : 0.0, row.pivots);
+        reduced = true;
+      };
+      auto cappedTrace = [&](size_t limit) {
+        if (row.limit == limit)
+          return std::move(row.trace);
+        reduceAgain();
+        return elimination.traceDependency(row.row, elimination.multipliers(), limit);
+      };
+      auto fullTrace = [&] {
+        reduceAgain();
+        return elimination.traceDependency(row.row, elimination.multipliers());
+      };
+      basis.stresses.push_back(resolve(find, cappedTrace, fullTrace));
+    }
   }
   basis.rank = elimination.rank();
   basis.smallestKeptPivot = elimination.smallestKeptPivot();
@@ -686,8 +304,9 @@ EliminationOrder leavesFirst(const EliminationOrder& order) {
 
 SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
                                        const SparseJacobian& J, double tolerance,
-                                       const ProgressCallback& progress, size_t fillBudget) {
+                                       const ProgressCallback& progress, size_t fillBudget, bool sideThread) {
   EliminationOrder order = computeSweepOrder(mechanism, model);
+  const bool findAhead = sideThread && J.rows() >= kFindAheadEquations;
   // A tree (only tree joints carry equations) has no loop for a stress to close, but swept from the ground
   // every reduced row is written in the free coordinates of all the links above it: the fill, and the time,
   // grow as the square of its depth (a 2 10^5-link chain ran out of memory). Swept from the leaves instead,
@@ -696,7 +315,8 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
                                 [&](const Joint& joint) { return joint.kind == ConnectionKind::TreeJoint; });
   std::optional<SelfStressBasis> found;
   if (tree) {
-    found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, FillBudget::none(), progress);
+    found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, FillBudget::none(), findAhead,
+                       progress);
   } else {
     // Loops can fill the same way: each arc of a long ring is such a chain, and swept from the ground the
     // 2.5 10^4 links of a ring stored 3 10^8 entries (10^5 links: out of memory). The sweep from the ground
@@ -713,11 +333,11 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
     const FillBudget budget = FillBudget::total(kFillFactor * static_cast<size_t>(J.nonZeros()) + kFillFloor);
     found = sweepBasis(mechanism, model, J, order, tolerance,
                        fillBudget > 0 ? FillBudget::total(fillBudget) : FillBudget::proportional(kFillFactor),
-                       progress);
+                       findAhead, progress);
     if (!found)
-      found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, budget, progress);
+      found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, budget, findAhead, progress);
     if (!found)
-      found = sweepBasis(mechanism, model, J, order, tolerance, FillBudget::none(), progress);
+      found = sweepBasis(mechanism, model, J, order, tolerance, FillBudget::none(), findAhead, progress);
   }
   SelfStressBasis basis = std::move(*found);
 

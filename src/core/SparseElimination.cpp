@@ -59,7 +59,8 @@ SparseElimination::Step SparseElimination::addRow(const SparseJacobian& J, int r
   return step;
 }
 
-SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r, double scale) {
+SparseElimination::Step SparseElimination::reduceOver(const SparseJacobian& J, int r, double scale,
+                                                      int numPivots) {
   reducedRow_ = r;
   for (int c : touched_) {
     values_[c] = 0.0;
@@ -77,7 +78,7 @@ SparseElimination::Step SparseElimination::reduce(const SparseJacobian& J, int r
     present_[column] = 1;
     touched_.push_back(column);
     const int pivot = pivotOfColumn_[column];
-    if (pivot > after)
+    if (pivot > after && pivot < numPivots)
       pending_.push(pivot);
   };
   if (scale > 0.0) {

@@ -15,6 +15,7 @@
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
+#include "mobility_analysis/generators/ScalingFamilies.hpp"
 // A private header of the core: its one test is here, beside the reductions that use it.
 #include "../../src/core/StressMatrix.hpp"
 
@@ -317,6 +318,60 @@ TEST(SelfStressBasis, TheStressesOfAGridOfContinuousBarsStayLocal) {
   EXPECT_LE(static_cast<double>(largeTotal), 4.5 * static_cast<double>(smallTotal))
       << smallTotal << " -> " << largeTotal;
   checkModel(large, "grid 20 x 20", false);
+}
+
+TEST(SparseElimination, ReducingOverTheFirstPivotsGivesTheReductionTheRowHadThen) {
+  // The sweep traces a dependent row after the elimination has gone past it (FindsAhead.hpp): reduced again
+  // over the pivot rows kept when it came, its multipliers and its trace must be those it had, to the bit.
+  std::mt19937 random(11);
+  const Eigen::MatrixXd dense = makeRankDeficientMatrix(random, 300, 120, 40);
+  const SparseJacobian J = dense.sparseView();
+  SparseElimination elimination(static_cast<int>(J.cols()), {}, tolerances::kRank, true);
+  struct Then {
+    int row, pivots;
+    std::vector<std::pair<int, double>> multipliers;
+    std::optional<SelfStress> trace;
+  };
+  std::vector<Then> dependent;
+  for (int r = 0; r < J.rows(); ++r) {
+    const double norm = J.row(r).norm();
+    if (elimination.addRow(J, r, 1.0 / norm).dependent) {
+      dependent.push_back(Then{r, elimination.rank(), elimination.multipliers(),
+                               elimination.traceDependency(r, elimination.multipliers())});
+    }
+  }
+  ASSERT_GT(dependent.size(), 50u);
+  ASSERT_GT(elimination.rank(), dependent.front().pivots);  // pivots came after the first dependent rows
+  for (const Then& then : dependent) {
+    elimination.reduceOver(J, then.row, 1.0 / J.row(then.row).norm(), then.pivots);
+    EXPECT_EQ(elimination.multipliers(), then.multipliers) << then.row;
+    EXPECT_EQ(elimination.traceDependency(then.row, elimination.multipliers()), then.trace) << then.row;
+  }
+}
+
+TEST(SelfStressBasis, FindsMadeAheadGiveTheOneThreadBasisToTheBit) {
+  // Above 2 10^4 equations a sweep allowed a second thread finds its local stresses ahead on it: a grid of
+  // continuous bars (balls in space first), a braced lattice (a trace, then a ball of links) and a ring
+  // pantograph with a cable net (some of each, some finds made from a state the sweep was not in, some
+  // traces made again at a higher limit). The basis must be the one-thread basis, entry for entry.
+  const std::vector<std::pair<std::string, MechanismDescription>> models = {
+      {"grid 60 x 60", makeParallelogramGrid(60, 60)},
+      {"braced 32 x 32", makeBarLattice(32, 32, true)},
+      {"net 1000", makeRingPantographNet(1000, 60.0)}};
+  for (const auto& [name, description] : models) {
+    SCOPED_TRACE(name);
+    const ModelAtTreePose m = assembleAtTreePose(generated(description), AnalysisMode::Planar);
+    ASSERT_GE(m.J.rows(), 20000);
+    const SelfStressBasis one =
+        computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank, {}, 0, false);
+    const SelfStressBasis two =
+        computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank, {}, 0, true);
+    ASSERT_GT(one.stresses.size(), 1000u);
+    EXPECT_EQ(one.rank, two.rank);
+    EXPECT_EQ(one.locallyResolved, two.locallyResolved);
+    EXPECT_TRUE(one.stresses == two.stresses);
+    EXPECT_EQ(one.smallestKeptPivot, two.smallestKeptPivot);
+  }
 }
 
 TEST(StressMatrix, EqualsTheTripletMatrixEntryForEntry) {

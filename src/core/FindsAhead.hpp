@@ -1,0 +1,222 @@
+#pragma once
+
+// Private to src/core: the sweep (SelfStressBasis.cpp) has the local stresses of its dependent rows found
+// ahead, on a second thread, while it eliminates.
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "LocalStressFinder.hpp"
+
+namespace mobility_analysis {
+namespace core_detail {
+
+/**
+ * Local stress finds made ahead of the sweep's decisions, each recorded with the finder state it was made
+ * from; the sweep takes one only when it is in that state, and finds for itself otherwise, so its stresses
+ * are those of the sweep on one thread to the bit (LocalStressFinder::State says why).
+ *
+ * Why: where most dependent rows need a local find (a grid of continuous bars, a braced lattice) the finds
+ * are most of the basis' time, and they read only J and the order. While the sweep eliminates, a worker
+ * thread takes the published rows from the front, following the sweep's rule for which rows are found and
+ * from which state (as well as it can know it: whether the sweep's trace succeeded comes with the row, the
+ * trace limit it guesses); once the elimination is done, the sweep's own thread takes rows from the back,
+ * from the worker's latest state (a regular structure stays in one state), until the two meet. A guess that
+ * was wrong costs the find it wasted and one made again, never a different stress.
+ */
+class FindsAhead {
+ public:
+  /// A find made ahead: from which state, its stress, and the state it left.
+  struct Find {
+    bool made = false;
+    LocalStressFinder::State from, after;
+    std::optional<SelfStress> stress;
+  };
+
+  /// @param[in] maxRows most dependent rows the sweep can publish (J's rows).
+  FindsAhead(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J,
+             const EliminationOrder& order, const std::vector<int>& position, double tolerance,
+             int futileLimit, size_t maxRows)
+      : mechanism_(mechanism),
+        model_(model),
+        J_(J),
+        order_(order),
+        position_(position),
+        tolerance_(tolerance),
+        futileLimit_(futileLimit),
+        chunks_(std::make_unique<std::unique_ptr<Slot[]>[]>(maxRows / kChunk + 1)) {}
+
+  FindsAhead(const FindsAhead&) = delete;
+  FindsAhead& operator=(const FindsAhead&) = delete;
+
+  /// Stops the worker (its unfinished find is finished first) and waits for it.
+  ~FindsAhead() {
+    stop_ = true;
+    close();
+  }
+
+  /// The sweep's thread, while eliminating: dependent row @p row, and whether the trace the sweep made at
+  /// once found its stress (false when it did not trace). Starts the worker at the first row.
+  void publish(int row, bool traced) {
+    const size_t k = published_.load(std::memory_order_relaxed);
+    if (k % kChunk == 0)
+      chunks_[k / kChunk] = std::make_unique<Slot[]>(kChunk);
+    Slot& slot = at(k);
+    slot.row = row;
+    slot.traced = traced;
+    published_.store(k + 1, std::memory_order_release);
+    if (!worker_.joinable())
+      worker_ = std::thread([this] { work(); });
+    if (k % kWakeEvery == 0)
+      wake_.notify_one();
+  }
+
+  /// The trace limit the sweep will have reached, as far as the worker's finds tell: twice the longest stress
+  /// it found after a failed trace (sweepBasis raises its limit so), or @p floor.
+  size_t traceLimitHint(size_t floor) const {
+    return std::max(floor, limitHint_.load(std::memory_order_relaxed));
+  }
+
+  /// Whether the worker's latest find put the finder in space-first mode (the sweep then need not trace at
+  /// once: it finds before it traces).
+  bool predictsSpaceFirst() const { return spaceFirst_.load(std::memory_order_relaxed); }
+
+  /// The sweep's thread, once the elimination is done: finds rows from the back with @p helper until it meets
+  /// the worker, then waits for the worker to finish.
+  void finish(LocalStressFinder& helper) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closed_ = true;
+    }
+    wake_.notify_one();
+    const size_t count = published_.load(std::memory_order_relaxed);
+    for (size_t k = count; k-- > 0;) {
+      Slot& slot = at(k);
+      int expected = kFree;
+      if (!slot.status.compare_exchange_strong(expected, kBack))
+        break;  // the worker has it, and everything before it
+      const LocalStressFinder::State guess = latest();
+      if (guess.inSpaceFirst || !slot.traced)
+        findInto(helper, slot, guess, 0);
+      slot.status.store(kDone, std::memory_order_release);
+    }
+    close();
+  }
+
+  /// Finds made ahead for the @p k-th published row (valid after finish()): at most two, in the order made.
+  Find* finds(size_t k) { return at(k).finds; }
+  size_t count() const { return published_.load(std::memory_order_relaxed); }
+
+ private:
+  static constexpr size_t kChunk = 4096;
+  static constexpr size_t kWakeEvery = 64;
+  enum Status : int { kFree = 0, kFront = 1, kBack = 2, kDone = 3 };
+
+  struct Slot {
+    int row = -1;
+    bool traced = false;
+    std::atomic<int> status{kFree};
+    Find finds[2];
+  };
+
+  Slot& at(size_t k) { return chunks_[k / kChunk][k % kChunk]; }
+
+  LocalStressFinder::State latest() {
+    std::lock_guard<std::mutex> lock(stateMutex_);
+    return latest_;
+  }
+
+  void findInto(LocalStressFinder& finder, Slot& slot, const LocalStressFinder::State& from, int which) {
+    finder.setState(from);
+    Find& find = slot.finds[which];
+    find.from = from;
+    find.stress = finder.find(slot.row);
+    find.after = finder.state();
+    find.made = true;
+  }
+
+  void close() {
+    if (worker_.joinable()) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        closed_ = true;
+      }
+      wake_.notify_one();
+      worker_.join();
+    }
+  }
+
+  /// The worker: the published rows from the front, following the sweep's rule (sweepBasis) for which rows
+  /// it finds and from which state, with what it knows of the sweep's traces.
+  void work() {
+    LocalStressFinder finder(mechanism_, model_, J_, order_, position_, tolerance_);
+    int futile = 0;
+    for (size_t k = 0;; ++k) {
+      if (k >= published_.load(std::memory_order_acquire)) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return stop_ || closed_ || k < published_.load(std::memory_order_acquire); });
+        if (stop_ || k >= published_.load(std::memory_order_acquire))
+          return;
+      }
+      if (stop_)
+        return;
+      Slot& slot = at(k);
+      int expected = kFree;
+      if (!slot.status.compare_exchange_strong(expected, kFront))
+        return;  // the sweep's thread has it, and everything after it
+      bool found = false;
+      int made = 0;
+      if (finder.inSpaceFirst() && futile < futileLimit_) {
+        findInto(finder, slot, finder.state(), made++);
+        found = slot.finds[0].stress.has_value();
+        if (!found)
+          ++futile;
+      }
+      if (!found && !slot.traced && futile < futileLimit_) {
+        findInto(finder, slot, finder.state(), made++);
+        found = slot.finds[made - 1].stress.has_value();
+        futile = found ? 0 : futile + 1;
+        if (found) {
+          const size_t limit = 2 * slot.finds[made - 1].stress->size();
+          if (limit > limitHint_.load(std::memory_order_relaxed))
+            limitHint_.store(limit, std::memory_order_relaxed);
+        }
+      }
+      {
+        std::lock_guard<std::mutex> lock(stateMutex_);
+        latest_ = finder.state();
+      }
+      spaceFirst_.store(finder.inSpaceFirst(), std::memory_order_relaxed);
+      slot.status.store(kDone, std::memory_order_release);
+    }
+  }
+
+  const Mechanism& mechanism_;
+  const CoordinateModel& model_;
+  const SparseJacobian& J_;
+  const EliminationOrder& order_;
+  const std::vector<int>& position_;
+  double tolerance_;
+  int futileLimit_;
+  /// Slots in chunks of kChunk, the chunk table sized for every row at once: a published slot never moves.
+  std::unique_ptr<std::unique_ptr<Slot[]>[]> chunks_;
+  std::atomic<size_t> published_{0};
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> spaceFirst_{false};
+  std::atomic<size_t> limitHint_{0};
+  bool closed_ = false;  ///< guarded by mutex_
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::mutex stateMutex_;
+  LocalStressFinder::State latest_;  ///< guarded by stateMutex_
+  std::thread worker_;
+};
+
+}  // namespace core_detail
+}  // namespace mobility_analysis
