@@ -4,7 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <sstream>
+#include <vector>
+
+#include "JsonHalves.hpp"
+#include "SideTask.hpp"
 
 namespace mobility_analysis {
 
@@ -201,23 +206,6 @@ std::string cableJson(const CableState& c) {
          ", \"length\": " + number(c.length) + ", \"distance\": " + number(c.distance) + "}";
 }
 
-template <class Out>
-void appendSelfStress(Out& out, const SelfStressInfo& s) {
-  out += "{\"count\": " + std::to_string(s.count) +
-         ", \"mechanism_modes\": " + std::to_string(s.mechanismModes) +
-         ", \"states_listed\": " + (s.statesListed ? "true" : "false") + ", \"states\": [";
-  for (size_t i = 0; i < s.states.size(); ++i) {
-    if (i)
-      out += ", ";
-    appendForces(out, s.states[i].elements);
-  }
-  out += "], \"taut_cables\": " + std::to_string(s.tautCables) +
-         ", \"prestressable\": " + (s.prestressable ? "true" : "false") + ", \"prestress\": ";
-  appendForces(out, s.prestress);
-  out += std::string(", \"prestress_stable\": ") + (s.prestressStable ? "true" : "false") +
-         ", \"stability\": " + quote(s.stability) + "}";
-}
-
 std::string deploymentJson(const DeploymentInfo& d) {
   std::string out =
       "{\"cable\": " + quote(d.cable) + ", \"initial_length\": " + number(d.initialLength) +
@@ -237,222 +225,394 @@ std::string deploymentJson(const DeploymentInfo& d) {
 }
 
 /// The JSON of @p r appended to @p text.
-void writeJson(const MobilityReport& r, std::string& text);
+/**
+ * The JSON text of a report as a sequence of parts, each written on its own, in order: a part is a fixed text
+ * and, for the long lists (states, joints, links, redundant constraints, the nullity trace, positions), its
+ * items, each part's opening and closing text around them. The concatenation of the parts is the report, byte
+ * for byte, wherever it is cut; toJson cuts a large report in two at about half its bytes and writes the
+ * halves on two threads.
+ */
+class JsonParts {
+ public:
+  explicit JsonParts(const MobilityReport& r);
+
+  /// A place in the text: before part @p part when @p item is 0, else within its list, after its opening and
+  /// its first @p item items.
+  struct Cut {
+    size_t part = 0;
+    size_t item = 0;
+  };
+  Cut begin() const { return {}; }
+  Cut end() const { return {parts_.size(), 0}; }
+  /// About half of the estimated bytes on either side.
+  Cut middle() const;
+  size_t estimatedBytes() const { return total_; }
+  /// Appends the text from @p from to @p to.
+  void write(std::string& text, Cut from, Cut to) const;
+
+ private:
+  struct Part {
+    std::function<void(BufferedAppender&)> open, close;
+    size_t items = 0;
+    std::function<void(BufferedAppender&, size_t)> item;  // item i, without the ", " before it
+    size_t fixedBytes = 0, itemBytes = 0;                 // estimates
+  };
+  void writePart(BufferedAppender& out, const Part& part, size_t from, size_t to, bool open,
+                 bool close) const;
+
+  std::vector<Part> parts_;
+  size_t total_ = 0;
+};
+
+/// From this many estimated bytes on, toJson writes the report's second half on a second thread: about 5 ms
+/// of writing, against tens of microseconds to start a thread.
+constexpr size_t kJsonSideThreadBytes = size_t{1} << 22;
 
 }  // namespace
 
 std::string toJson(const MobilityReport& r) {
+  return core_detail::toJson(r, kJsonSideThreadBytes);
+}
+
+std::string core_detail::toJson(const MobilityReport& r, size_t secondThreadFrom) {
   // One string, appended to in place (through a buffer, BufferedAppender): the links, joints and positions of
   // a 10^5-link chain are 3 10^5 small objects, each once built apart and copied in.
   // Room for all of it at once, from the sizes of its parts: grown by doubling from too small a guess, a
   // report whose listed states are most of it (a 100 x 100 grid of continuous bars: 21 MB, 19 800 states)
-  // was copied three times over and touched 36 MB of fresh pages. The constants are each record's fixed text
+  // was copied three times over and touched 36 MB of fresh pages. The estimates are each record's fixed text
   // with its numbers.
-  size_t size = 4096 + 96 * (r.links.size() + r.joints.size()) + 48 * r.positions.size() +
-                8 * r.nullityTrace.size() + 80 * r.redundantJoints.size() + 4 * r.selfStress.states.size();
-  for (const CableState& c : r.cables)  // {"name": "", "type": "", "state": "", "length": , "distance": }
-    size += 96 + c.name.size();
-  for (const RedundantConstraint& c : r.redundantConstraints)
-    size += 96 + c.source.size() + c.name.size() + c.kind.size() + c.equation.size() + c.cause.size();
-  auto addForces = [&size](const std::vector<ElementForce>& elements) {
-    for (const ElementForce& element : elements)  // {"name": "", "kind": "", "force": } and a number
-      size += 48 + element.name.size() + element.kind.size();
-  };
-  for (const SelfStressState& state : r.selfStress.states)
-    addForces(state.elements);
-  addForces(r.selfStress.prestress);
+  const JsonParts parts(r);
+  const size_t size = parts.estimatedBytes();
   std::string text;
   text.reserve(size + size / 16);  // a margin: a doubling at the very end would copy all of it once more
-  writeJson(r, text);
+  if (size < secondThreadFrom) {
+    parts.write(text, parts.begin(), parts.end());
+    return text;
+  }
+  // The second half on another thread, into its own string, then appended: the copy costs a fiftieth of the
+  // writing.
+  const JsonParts::Cut middle = parts.middle();
+  core_detail::SideTask secondHalf(true, [&] {
+    std::string half;
+    half.reserve(size / 2 + size / 16);
+    parts.write(half, middle, parts.end());
+    return half;
+  });
+  parts.write(text, parts.begin(), middle);
+  text += secondHalf.get();
   return text;
 }
 
 namespace {
 
-void writeJson(const MobilityReport& r, std::string& text) {
-  BufferedAppender out(text);
-  auto integer = [&out](long long value) {
-    char digits[24];
-    out.append(digits, std::to_chars(digits, digits + sizeof(digits), value).ptr);
-  };
-  auto boolean = [&out](bool value) { out += value ? "true" : "false"; };
-  // "[a, b, …]" with each item appended by @p write.
-  auto list = [&out](const auto& items, auto&& write) {
-    out += '[';
-    for (size_t i = 0; i < items.size(); ++i) {
-      if (i)
-        out += ", ";
-      write(items[i]);
-    }
-    out += ']';
-  };
-  auto quoted = [&out](const std::string& text) { appendQuoted(out, text); };
-  auto field = [&out](const char* name) {  // "  \"name\": "
-    out += "  \"";
-    out += name;
-    out += "\": ";
-  };
-  out += "{\n";
-  field("robot");
-  quoted(r.robot);
-  out += ",\n";
-  field("file");
-  quoted(r.file);
-  out += ",\n";
-  field("mode");
-  quoted(r.mode);
-  out += ",\n";
-  const std::pair<const char*, int> counts[] = {{"lambda", r.lambda},
-                                                {"dof", r.dof},
-                                                {"grubler_kutzbach_dof", r.grublerKutzbachDof},
-                                                {"num_coordinates", r.numCoordinates},
-                                                {"num_constraints", r.numConstraints},
-                                                {"rank", r.rank},
-                                                {"num_redundant", r.numRedundant},
-                                                {"finite_dof", r.finiteDof}};
-  for (const auto& [name, value] : counts) {
-    field(name);
-    integer(value);
-    out += ",\n";
-  }
-  field("singular");
-  boolean(r.singular);
-  out += ",\n";
-  field("passive_dof");
-  integer(r.passiveDof);
-  out += ",\n";
-  field("output_dof");
-  integer(r.outputDof);
-  out += ",\n";
-  field("passive_motions");
-  list(r.passiveMotions, [&](const PassiveMotion& m) {
-    out += "{\"links\": ";
-    list(m.links, quoted);
-    out += ", \"description\": ";
-    quoted(m.description);
-    out += '}';
-  });
-  out += ",\n";
-  field("nullity_trace");
-  list(r.nullityTrace, [&](int v) { integer(v); });
-  out += ",\n";
-  field("redundant_constraints");
-  list(r.redundantConstraints, [&](const RedundantConstraint& c) {
-    out += "{\"index\": ";
-    integer(c.index);
-    out += ", \"source\": ";
-    quoted(c.source);
-    out += ", \"name\": ";
-    quoted(c.name);
-    out += ", \"kind\": ";
-    quoted(c.kind);
-    out += ", \"equation\": ";
-    quoted(c.equation);
-    out += ", \"cause\": ";
-    quoted(c.cause);
-    out += '}';
-  });
-  out += ",\n";
-  field("redundant_joints");
-  list(r.redundantJoints, [&](const RedundantJoint& j) {
-    out += "{\"name\": ";
-    quoted(j.name);
-    out += ", \"redundant_equations\": ";
-    integer(j.redundantEquations);
-    out += ", \"equations\": ";
-    integer(j.equations);
-    out += '}';
-  });
-  out += ",\n";
-  field("redundant_links");
-  list(r.redundantLinks, quoted);
-  out += ",\n";
-  field("redundant_links_computed");
-  boolean(r.redundantLinksComputed);
-  out += ",\n";
-  field("redundant_boundaries");
-  list(r.redundantBoundaries, quoted);
-  out += ",\n";
-  auto status = [&](const ElementStatus& e) {
-    out += "{\"name\": ";
-    quoted(e.name);
-    out += ", \"kind\": ";
-    quoted(e.kind);
-    out += ", \"type\": ";
-    quoted(e.type);
-    out += ", \"class\": \"";
-    out += toString(e.elementClass);  // a fixed word, nothing to escape
-    out += '"';
-    out += '}';
-  };
-  field("links");
-  list(r.links, status);
-  out += ",\n";
-  field("joints");
-  list(r.joints, status);
-  out += ",\n";
-  field("cables");
-  list(r.cables, [&](const CableState& c) {
-    out += "{\"name\": ";
-    quoted(c.name);
-    out += ", \"type\": ";
-    quoted(c.type);
-    out += ", \"state\": ";
-    quoted(c.state);
-    out += ", \"length\": ";
-    appendNumber(out, c.length);
-    out += ", \"distance\": ";
-    appendNumber(out, c.distance);
-    out += '}';
-  });
-  out += ",\n";
-  field("rank_margin");
-  out += "{\"tolerance\": ";
-  appendNumber(out, r.rankMargin.tolerance, 3);
-  out += ", \"smallest_kept_pivot\": ";
-  appendNumber(out, r.rankMargin.smallestKeptPivot, 3);
-  out += ", \"largest_dropped_residual\": ";
-  appendNumber(out, r.rankMargin.largestDroppedResidual, 3);
-  out += ", \"near_tolerance\": ";
-  boolean(r.rankMargin.nearTolerance);
-  out += "},\n";
-  field("characteristic_length");
-  appendNumber(out, r.characteristicLength);
-  out += ",\n";
-  field("closure_residual");
-  out += "{\"before\": ";
-  appendNumber(out, r.closureResidualBefore, 3);
-  out += ", \"after\": ";
-  appendNumber(out, r.closureResidualAfter, 3);
-  out += "},\n";
-  field("positions");
-  out += '{';
-  for (size_t i = 0; i < r.positions.size(); ++i) {
+// Writers of the pieces the parts are made of.
+void appendInteger(BufferedAppender& out, long long value) {
+  char digits[24];
+  out.append(digits, std::to_chars(digits, digits + sizeof(digits), value).ptr);
+}
+void appendBoolean(BufferedAppender& out, bool value) {
+  out += value ? "true" : "false";
+}
+void appendField(BufferedAppender& out, const char* name) {  // "  \"name\": "
+  out += "  \"";
+  out += name;
+  out += "\": ";
+}
+/// "[a, b, …]" with each item appended by @p write.
+template <class Items, class Write>
+void appendList(BufferedAppender& out, const Items& items, Write&& write) {
+  out += '[';
+  for (size_t i = 0; i < items.size(); ++i) {
     if (i)
       out += ", ";
-    quoted(r.positions[i].name);
-    out += ": ";
-    appendNumber(out, r.positions[i].value, 12);
+    write(items[i]);
   }
-  out += "},\n";
-  field("assembly");
-  out += "{\"residual\": ";
-  appendNumber(out, r.assembly.residual, 3);
-  out += ", \"steps\": ";
-  integer(r.assembly.steps);
-  out += ", \"iterations\": ";
-  integer(r.assembly.iterations);
-  out += ", \"events\": ";
-  list(r.assembly.events, quoted);
-  out += "},\n";
-  field("self_stress");
-  appendSelfStress(out, r.selfStress);
-  out += ",\n";
-  if (r.deployment)
-    out += "  \"deployment\": " + deploymentJson(*r.deployment) + ",\n";
-  field("warnings");
-  list(r.warnings, quoted);
-  out += "\n}\n";
+  out += ']';
+}
+void appendStatus(BufferedAppender& out, const ElementStatus& e) {
+  out += "{\"name\": ";
+  appendQuoted(out, e.name);
+  out += ", \"kind\": ";
+  appendQuoted(out, e.kind);
+  out += ", \"type\": ";
+  appendQuoted(out, e.type);
+  out += ", \"class\": \"";
+  out += toString(e.elementClass);  // a fixed word, nothing to escape
+  out += '"';
+  out += '}';
+}
+size_t forcesBytes(const std::vector<ElementForce>& elements) {
+  size_t bytes = 2;
+  for (const ElementForce& element : elements)  // {"name": "", "kind": "", "force": } and a number
+    bytes += 48 + element.name.size() + element.kind.size();
+  return bytes;
+}
+
+JsonParts::JsonParts(const MobilityReport& r) {
+  auto fixed = [&](size_t bytes, std::function<void(BufferedAppender&)> write) {
+    Part part;
+    part.open = std::move(write);
+    part.fixedBytes = bytes;
+    parts_.push_back(std::move(part));
+  };
+  // A list field: "  \"name\": [" items "]" and what follows it up to the next part.
+  auto list = [&](size_t items, size_t itemBytes, std::function<void(BufferedAppender&)> open,
+                  std::function<void(BufferedAppender&, size_t)> item,
+                  std::function<void(BufferedAppender&)> close) {
+    Part part;
+    part.open = std::move(open);
+    part.close = std::move(close);
+    part.items = items;
+    part.item = std::move(item);
+    part.fixedBytes = 64;
+    part.itemBytes = itemBytes;
+    parts_.push_back(std::move(part));
+  };
+  auto fieldOpen = [](const char* name, char bracket) {
+    return [name, bracket](BufferedAppender& out) {
+      appendField(out, name);
+      out += bracket;
+    };
+  };
+  auto closeWith = [](const char* text) { return [text](BufferedAppender& out) { out += text; }; };
+
+  fixed(1024, [&r](BufferedAppender& out) {
+    out += "{\n";
+    appendField(out, "robot");
+    appendQuoted(out, r.robot);
+    out += ",\n";
+    appendField(out, "file");
+    appendQuoted(out, r.file);
+    out += ",\n";
+    appendField(out, "mode");
+    appendQuoted(out, r.mode);
+    out += ",\n";
+    const std::pair<const char*, int> counts[] = {{"lambda", r.lambda},
+                                                  {"dof", r.dof},
+                                                  {"grubler_kutzbach_dof", r.grublerKutzbachDof},
+                                                  {"num_coordinates", r.numCoordinates},
+                                                  {"num_constraints", r.numConstraints},
+                                                  {"rank", r.rank},
+                                                  {"num_redundant", r.numRedundant},
+                                                  {"finite_dof", r.finiteDof}};
+    for (const auto& [name, value] : counts) {
+      appendField(out, name);
+      appendInteger(out, value);
+      out += ",\n";
+    }
+    appendField(out, "singular");
+    appendBoolean(out, r.singular);
+    out += ",\n";
+    appendField(out, "passive_dof");
+    appendInteger(out, r.passiveDof);
+    out += ",\n";
+    appendField(out, "output_dof");
+    appendInteger(out, r.outputDof);
+    out += ",\n";
+    appendField(out, "passive_motions");
+    appendList(out, r.passiveMotions, [&](const PassiveMotion& m) {
+      out += "{\"links\": ";
+      appendList(out, m.links, [&](const std::string& link) { appendQuoted(out, link); });
+      out += ", \"description\": ";
+      appendQuoted(out, m.description);
+      out += '}';
+    });
+    out += ",\n";
+  });
+  list(
+      r.nullityTrace.size(), 8, fieldOpen("nullity_trace", '['),
+      [&r](BufferedAppender& out, size_t i) { appendInteger(out, r.nullityTrace[i]); }, closeWith("],\n"));
+  size_t constraintBytes = 96;
+  for (const RedundantConstraint& c : r.redundantConstraints)
+    constraintBytes += c.source.size() + c.name.size() + c.kind.size() + c.equation.size() + c.cause.size();
+  list(
+      r.redundantConstraints.size(),
+      r.redundantConstraints.empty() ? 96 : constraintBytes / r.redundantConstraints.size(),
+      fieldOpen("redundant_constraints", '['),
+      [&r](BufferedAppender& out, size_t i) {
+        const RedundantConstraint& c = r.redundantConstraints[i];
+        out += "{\"index\": ";
+        appendInteger(out, c.index);
+        out += ", \"source\": ";
+        appendQuoted(out, c.source);
+        out += ", \"name\": ";
+        appendQuoted(out, c.name);
+        out += ", \"kind\": ";
+        appendQuoted(out, c.kind);
+        out += ", \"equation\": ";
+        appendQuoted(out, c.equation);
+        out += ", \"cause\": ";
+        appendQuoted(out, c.cause);
+        out += '}';
+      },
+      closeWith("],\n"));
+  list(
+      r.redundantJoints.size(), 80, fieldOpen("redundant_joints", '['),
+      [&r](BufferedAppender& out, size_t i) {
+        const RedundantJoint& j = r.redundantJoints[i];
+        out += "{\"name\": ";
+        appendQuoted(out, j.name);
+        out += ", \"redundant_equations\": ";
+        appendInteger(out, j.redundantEquations);
+        out += ", \"equations\": ";
+        appendInteger(out, j.equations);
+        out += '}';
+      },
+      closeWith("],\n"));
+  fixed(64 + 32 * (r.redundantLinks.size() + r.redundantBoundaries.size()), [&r](BufferedAppender& out) {
+    auto quoted = [&out](const std::string& text) { appendQuoted(out, text); };
+    appendField(out, "redundant_links");
+    appendList(out, r.redundantLinks, quoted);
+    out += ",\n";
+    appendField(out, "redundant_links_computed");
+    appendBoolean(out, r.redundantLinksComputed);
+    out += ",\n";
+    appendField(out, "redundant_boundaries");
+    appendList(out, r.redundantBoundaries, quoted);
+    out += ",\n";
+  });
+  list(
+      r.links.size(), 96, fieldOpen("links", '['),
+      [&r](BufferedAppender& out, size_t i) { appendStatus(out, r.links[i]); }, closeWith("],\n"));
+  list(
+      r.joints.size(), 96, fieldOpen("joints", '['),
+      [&r](BufferedAppender& out, size_t i) { appendStatus(out, r.joints[i]); }, closeWith("],\n"));
+  list(
+      r.cables.size(), 112, fieldOpen("cables", '['),
+      [&r](BufferedAppender& out, size_t i) {
+        const CableState& c = r.cables[i];
+        out += "{\"name\": ";
+        appendQuoted(out, c.name);
+        out += ", \"type\": ";
+        appendQuoted(out, c.type);
+        out += ", \"state\": ";
+        appendQuoted(out, c.state);
+        out += ", \"length\": ";
+        appendNumber(out, c.length);
+        out += ", \"distance\": ";
+        appendNumber(out, c.distance);
+        out += '}';
+      },
+      closeWith("],\n"));
+  fixed(256, [&r](BufferedAppender& out) {
+    appendField(out, "rank_margin");
+    out += "{\"tolerance\": ";
+    appendNumber(out, r.rankMargin.tolerance, 3);
+    out += ", \"smallest_kept_pivot\": ";
+    appendNumber(out, r.rankMargin.smallestKeptPivot, 3);
+    out += ", \"largest_dropped_residual\": ";
+    appendNumber(out, r.rankMargin.largestDroppedResidual, 3);
+    out += ", \"near_tolerance\": ";
+    appendBoolean(out, r.rankMargin.nearTolerance);
+    out += "},\n";
+    appendField(out, "characteristic_length");
+    appendNumber(out, r.characteristicLength);
+    out += ",\n";
+    appendField(out, "closure_residual");
+    out += "{\"before\": ";
+    appendNumber(out, r.closureResidualBefore, 3);
+    out += ", \"after\": ";
+    appendNumber(out, r.closureResidualAfter, 3);
+    out += "},\n";
+  });
+  list(
+      r.positions.size(), 48, fieldOpen("positions", '{'),
+      [&r](BufferedAppender& out, size_t i) {
+        appendQuoted(out, r.positions[i].name);
+        out += ": ";
+        appendNumber(out, r.positions[i].value, 12);
+      },
+      closeWith("},\n"));
+  fixed(128 + 16 * r.assembly.events.size(), [&r](BufferedAppender& out) {
+    appendField(out, "assembly");
+    out += "{\"residual\": ";
+    appendNumber(out, r.assembly.residual, 3);
+    out += ", \"steps\": ";
+    appendInteger(out, r.assembly.steps);
+    out += ", \"iterations\": ";
+    appendInteger(out, r.assembly.iterations);
+    out += ", \"events\": ";
+    appendList(out, r.assembly.events, [&out](const std::string& text) { appendQuoted(out, text); });
+    out += "},\n";
+  });
+  // self_stress: its states, then its prestress, each a list of its own.
+  const SelfStressInfo& s = r.selfStress;
+  size_t stateBytes = 0;
+  for (const SelfStressState& state : s.states)
+    stateBytes += forcesBytes(state.elements);
+  list(
+      s.states.size(), s.states.empty() ? 0 : stateBytes / s.states.size(),
+      [&s](BufferedAppender& out) {
+        appendField(out, "self_stress");
+        out += "{\"count\": " + std::to_string(s.count) +
+               ", \"mechanism_modes\": " + std::to_string(s.mechanismModes) +
+               ", \"states_listed\": " + (s.statesListed ? "true" : "false") + ", \"states\": [";
+      },
+      [&s](BufferedAppender& out, size_t i) { appendForces(out, s.states[i].elements); },
+      [&s](BufferedAppender& out) {
+        out += "], \"taut_cables\": " + std::to_string(s.tautCables) +
+               ", \"prestressable\": " + (s.prestressable ? "true" : "false") + ", \"prestress\": [";
+      });
+  list(
+      s.prestress.size(), s.prestress.empty() ? 0 : forcesBytes(s.prestress) / s.prestress.size(), {},
+      [&s](BufferedAppender& out, size_t i) { appendForce(out, s.prestress[i]); },
+      [&s](BufferedAppender& out) {
+        out += ']';
+        out += std::string(", \"prestress_stable\": ") + (s.prestressStable ? "true" : "false") +
+               ", \"stability\": " + quote(s.stability) + "}";
+        out += ",\n";
+      });
+  fixed(256 + 64 * r.warnings.size(), [&r](BufferedAppender& out) {
+    if (r.deployment)
+      out += "  \"deployment\": " + deploymentJson(*r.deployment) + ",\n";
+    appendField(out, "warnings");
+    appendList(out, r.warnings, [&out](const std::string& text) { appendQuoted(out, text); });
+    out += "\n}\n";
+  });
+  for (const Part& part : parts_)
+    total_ += part.fixedBytes + part.items * part.itemBytes;
+}
+
+JsonParts::Cut JsonParts::middle() const {
+  size_t before = 0;
+  for (size_t p = 0; p < parts_.size(); ++p) {
+    const Part& part = parts_[p];
+    const size_t bytes = part.fixedBytes + part.items * part.itemBytes;
+    if (2 * (before + bytes) >= total_) {
+      if (part.items == 0 || part.itemBytes == 0)
+        return {p + 1, 0};
+      const size_t wanted =
+          (total_ / 2 > before + part.fixedBytes) ? total_ / 2 - before - part.fixedBytes : 0;
+      return {p, std::min(part.items, wanted / part.itemBytes)};
+    }
+    before += bytes;
+  }
+  return end();
+}
+
+void JsonParts::write(std::string& text, Cut from, Cut to) const {
+  BufferedAppender out(text);
+  // A cut {p, 0} is before part p; a cut {p, i > 0} inside its list, after its opening and i items.
+  const size_t endPart = std::min(parts_.size(), to.item > 0 ? to.part + 1 : to.part);
+  for (size_t p = from.part; p < endPart; ++p) {
+    const Part& part = parts_[p];
+    const bool inside = p == from.part && from.item > 0;  // starts within the list: its opening is before
+    const bool last = p == to.part;                       // ends within the list: its close is after
+    writePart(out, part, p == from.part ? from.item : 0, last ? to.item : part.items, !inside, !last);
+  }
+}
+
+void JsonParts::writePart(BufferedAppender& out, const Part& part, size_t from, size_t to, bool open,
+                          bool close) const {
+  if (open && part.open)
+    part.open(out);
+  for (size_t i = from; i < to; ++i) {
+    if (i)
+      out += ", ";
+    part.item(out, i);
+  }
+  if (close && part.close)
+    part.close(out);
 }
 
 }  // namespace

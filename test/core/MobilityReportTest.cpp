@@ -1,10 +1,13 @@
 #include "mobility_analysis/MobilityReport.hpp"
 
+#include <limits>
 #include <regex>
 
 #include <gtest/gtest.h>
 
 #include "core/TestModels.hpp"
+// A private header of the core: toJson with its threshold for the second thread.
+#include "../../src/core/JsonHalves.hpp"
 
 using namespace mobility_analysis;
 
@@ -13,8 +16,8 @@ namespace {
 /// The JSON without the fields that carry the unit or the file name.
 std::string unitFree(std::string json) {
   // positions carry rounding noise of the pose (1e-16 rad) and assembly.residual is in metres.
-  for (const char* key :
-       {"robot", "file", "characteristic_length", "closure_residual", "rank_margin", "positions", "assembly"}) {
+  for (const char* key : {"robot", "file", "characteristic_length", "closure_residual", "rank_margin",
+                          "positions", "assembly"}) {
     json = std::regex_replace(json, std::regex(std::string("\\n  \"") + key + "\": [^\\n]*"), "");
   }
   return json;
@@ -23,12 +26,14 @@ std::string unitFree(std::string json) {
 }  // namespace
 
 TEST(MobilityReport, JsonCarriesEveryDocumentedKey) {
-  const MobilityReport report = analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Spatial).report;
+  const MobilityReport report =
+      analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Spatial).report;
   const std::string json = toJson(report);
   for (const char* key :
        {"\"robot\": \"four_bar\"", "\"mode\": \"spatial\"", "\"lambda\": 6", "\"dof\": 1",
-        "\"grubler_kutzbach_dof\": -2", "\"num_coordinates\": ", "\"num_constraints\": ", "\"rank\": ",
-        "\"nullity_trace\": [", "\"redundant_constraints\": [{\"index\": ", "\"source\": \"joint\", \"name\": \"j4\"",
+        "\"grubler_kutzbach_dof\": -2",
+        "\"num_coordinates\": ", "\"num_constraints\": ", "\"rank\": ", "\"nullity_trace\": [",
+        "\"redundant_constraints\": [{\"index\": ", "\"source\": \"joint\", \"name\": \"j4\"",
         "\"redundant_joints\": [{\"name\": \"j4\", \"redundant_equations\": 3, \"equations\": 5}]",
         "\"redundant_links\": []", "\"redundant_boundaries\": []", "\"rank_margin\": {"}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
@@ -45,8 +50,10 @@ TEST(MobilityReport, JsonEscapesNames) {
 }
 
 TEST(MobilityReport, TextSaysDofGrublerAndTheRedundantJoint) {
-  const std::string text = toText(analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Spatial).report);
-  EXPECT_NE(text.find("degrees of freedom (nullity of the constraint Jacobian): 1"), std::string::npos) << text;
+  const std::string text =
+      toText(analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Spatial).report);
+  EXPECT_NE(text.find("degrees of freedom (nullity of the constraint Jacobian): 1"), std::string::npos)
+      << text;
   EXPECT_NE(text.find("joint j4: 3 of 5 equations redundant"), std::string::npos) << text;
 }
 
@@ -60,11 +67,66 @@ TEST(MobilityReport, BennettInMillimetresAndMetresGiveTheSameReport) {
 }
 
 TEST(MobilityReport, ElementClassesMarkTheLoopJointRedAndTheLoopOrange) {
-  const MobilityReport report = analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Spatial).report;
+  const MobilityReport report =
+      analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Spatial).report;
   for (const ElementStatus& s : report.joints) {
-    EXPECT_EQ(s.elementClass, s.name == "j4" ? ElementClass::Redundant : ElementClass::OverConstrainedLoop) << s.name;
+    EXPECT_EQ(s.elementClass, s.name == "j4" ? ElementClass::Redundant : ElementClass::OverConstrainedLoop)
+        << s.name;
   }
-  for (const ElementStatus& s : report.links) EXPECT_EQ(s.elementClass, ElementClass::OverConstrainedLoop) << s.name;
-  const MobilityReport planar = analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Planar).report;
-  for (const ElementStatus& s : planar.joints) EXPECT_EQ(s.elementClass, ElementClass::Neutral) << s.name;
+  for (const ElementStatus& s : report.links)
+    EXPECT_EQ(s.elementClass, ElementClass::OverConstrainedLoop) << s.name;
+  const MobilityReport planar =
+      analyzeOrFail(fixturePath("four_bar_closed.urdf"), AnalysisMode::Planar).report;
+  for (const ElementStatus& s : planar.joints)
+    EXPECT_EQ(s.elementClass, ElementClass::Neutral) << s.name;
+}
+
+namespace {
+
+/// A report whose one list @p which holds @p n items and whose others are short (or empty).
+MobilityReport reportWithLong(const std::string& which, size_t n) {
+  MobilityReport r = analyzeOrFail(urdfPath("ring_pantograph_deployed.urdf"), AnalysisMode::Planar).report;
+  for (size_t i = 0; i < n; ++i) {
+    const std::string name = "e\"" + std::to_string(i);  // escaped, of growing length
+    if (which == "nullity_trace")
+      r.nullityTrace.push_back(static_cast<int>(i));
+    if (which == "redundant_constraints")
+      r.redundantConstraints.push_back(
+          RedundantConstraint{static_cast<int>(i), "joint", name, "x", "x_a = x_b"});
+    if (which == "links")
+      r.links.push_back(ElementStatus{name, "link", "link", ElementClass::Neutral});
+    if (which == "joints")
+      r.joints.push_back(ElementStatus{name, "joint", "revolute", ElementClass::Redundant});
+    if (which == "positions")
+      r.positions.push_back(JointValue{name, 0.1 * static_cast<double>(i)});
+    if (which == "states")
+      r.selfStress.states.push_back(
+          SelfStressState{{ElementForce{name, "link", 1.0}, ElementForce{name, "cable", -0.5}}});
+    if (which == "prestress")
+      r.selfStress.prestress.push_back(ElementForce{name, "cable", 1.0 / static_cast<double>(i + 1)});
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(MobilityReport, JsonInTwoHalvesIsTheSameText) {
+  // A large report is written in two halves on two threads (core_detail::toJson), cut at about half its
+  // estimated bytes: inside whichever list holds them, or between parts. Every place the cut can fall must
+  // give the one-thread text: each list made long in turn, at sizes that move the cut along it, and the
+  // bundled models as they are (their cut falls between small parts).
+  for (const char* which : {"nullity_trace", "redundant_constraints", "links", "joints", "positions",
+                            "states", "prestress", "none"}) {
+    for (size_t n : {0, 1, 2, 7, 100, 5000}) {
+      SCOPED_TRACE(std::string(which) + " " + std::to_string(n));
+      const MobilityReport r = reportWithLong(which, n);
+      const std::string one = core_detail::toJson(r, std::numeric_limits<size_t>::max());
+      EXPECT_EQ(core_detail::toJson(r, 0), one);
+      EXPECT_EQ(toJson(r), one);
+    }
+  }
+  for (const char* file : {"bennett.urdf", "sle_deployable_deployed.urdf", "door.urdf"}) {
+    const MobilityReport r = analyzeOrFail(urdfPath(file), AnalysisMode::Auto).report;
+    EXPECT_EQ(core_detail::toJson(r, 0), core_detail::toJson(r, std::numeric_limits<size_t>::max())) << file;
+  }
 }
