@@ -177,7 +177,9 @@ int main(int argc, char** argv) {
     AnalysisOptions options;
     options.mode = valueOf(mode);
     // Where the analysis goes: the processor seconds from each phase the analysis announces to the next (on
-    // stderr; processor time, not wall clock, so that figures taken on a shared machine compare).
+    // stderr; processor time, not wall clock, so that figures taken on a shared machine compare). The process'
+    // time: on a large model the work of the second thread (finds made ahead, the passive-freedom search, the
+    // self-stress report, the second half of the JSON) counts in the phase the main thread is in meanwhile.
     std::vector<std::pair<std::string, double>> phases;
     options.progress = [&](const std::string& phase, double) {
       if (phases.empty() || phases.back().first != phase) phases.emplace_back(phase, cpuSeconds());
