@@ -72,7 +72,7 @@ double cpuSeconds() {
 }
 
 constexpr const char* kUsage =
-    "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|load|slvs|orders FILE.urdf [--mode M] [--budget S] [--orientation auto|J|JT]";
+    "usage: mobility_benchmark --method full|finite|literal|dense|spqr|parse|load|slvs|orders FILE.urdf [--mode M] [--budget S] [--orientation auto|J|JT] [--one-thread]";
 
 /// The mechanism assembled from its tree pose and the constraint Jacobian there: what the baselines (spqr,
 /// dense, literal, orders) are handed, built outside their timed regions.
@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
   std::string method = "full", file, modeText = "auto";
   double budget = 60.0;
   std::string orientation = "auto";  // spqr: factor J, J^T, or (auto) whichever is wide
+  bool oneThread = false;            // full: no second thread (AnalysisOptions::sideThreads, toJson)
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if ((arg == "--method" || arg == "--mode" || arg == "--budget" || arg == "--orientation") && i + 1 < argc) {
@@ -108,6 +109,8 @@ int main(int argc, char** argv) {
       if (arg == "--mode") modeText = value;
       if (arg == "--budget") budget = std::stod(value);
       if (arg == "--orientation") orientation = value;
+    } else if (arg == "--one-thread") {
+      oneThread = true;
     } else if (file.empty() && arg[0] != '-') {
       file = arg;
     } else {
@@ -176,6 +179,7 @@ int main(int argc, char** argv) {
   if (method == "full") {
     AnalysisOptions options;
     options.mode = valueOf(mode);
+    options.sideThreads = !oneThread;
     // Where the analysis goes: the processor seconds from each phase the analysis announces to the next (on
     // stderr; processor time, not wall clock, so that figures taken on a shared machine compare). The process'
     // time: on a large model the work of the second thread (finds made ahead, the passive-freedom search, the
@@ -194,7 +198,7 @@ int main(int argc, char** argv) {
     const MobilityReport& report = valueOf(analysis).report;
     const double analysisSeconds = seconds() - loadSeconds;
     const Phase json{"json", cpuSeconds(), seconds()};
-    const std::string text = toJson(report);
+    const std::string text = toJson(report, !oneThread);
     phases.push_back(json);
     phases.push_back({"", cpuSeconds(), seconds()});
     std::fprintf(stderr, "cpu seconds: load %.3f", loadCpuSeconds);

@@ -172,6 +172,9 @@ struct MobilityReport {
  *       report use writeJson, which refuses such a report instead.
  */
 std::string toJson(const MobilityReport& report);
+/// toJson, written on the caller's thread alone when @p sideThread is false (a large report is otherwise
+/// written in two halves on two threads; the text is the same).
+std::string toJson(const MobilityReport& report, bool sideThread);
 
 /**
  * @brief The report's own invariants: every number finite, characteristic length positive,
@@ -181,8 +184,9 @@ std::string toJson(const MobilityReport& report);
  */
 std::optional<Diagnostic> checkReport(const MobilityReport& report);
 
-/// @return toJson(report) once checkReport holds, else its Diagnostic: a report is only written when sound.
-Result<std::string> writeJson(const MobilityReport& report);
+/// @return toJson(report, sideThread) once checkReport holds, else its Diagnostic: a report is only written
+/// when sound.
+Result<std::string> writeJson(const MobilityReport& report, bool sideThread = true);
 
 /// @return toText(report) once checkReport holds, else its Diagnostic.
 Result<std::string> writeText(const MobilityReport& report);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -271,7 +272,11 @@ constexpr size_t kJsonSideThreadBytes = size_t{1} << 22;
 }  // namespace
 
 std::string toJson(const MobilityReport& r) {
-  return core_detail::toJson(r, kJsonSideThreadBytes);
+  return toJson(r, true);
+}
+
+std::string toJson(const MobilityReport& r, bool sideThread) {
+  return core_detail::toJson(r, sideThread ? kJsonSideThreadBytes : std::numeric_limits<size_t>::max());
 }
 
 std::string core_detail::toJson(const MobilityReport& r, size_t secondThreadFrom) {
@@ -780,10 +785,10 @@ std::optional<Diagnostic> checkReport(const MobilityReport& r) {
   return std::nullopt;
 }
 
-Result<std::string> writeJson(const MobilityReport& report) {
+Result<std::string> writeJson(const MobilityReport& report, bool sideThread) {
   if (std::optional<Diagnostic> d = checkReport(report))
     return *d;
-  return toJson(report);
+  return toJson(report, sideThread);
 }
 
 Result<std::string> writeText(const MobilityReport& report) {

@@ -29,7 +29,7 @@ const char* kUsage =
     "usage: mobility_report FILE.urdf|FILE.xml|FILE.sdf [--closures FILE.yaml] [--strict] [--mode "
     "auto|planar|spatial] "
     "[--positions j1=0.3,j2=-1] [--rank-tolerance T] [--lock-active-cables] "
-    "[--deploy CABLE [--steps N] [--deploy-to LENGTH]] [--json]";
+    "[--deploy CABLE [--steps N] [--deploy-to LENGTH]] [--one-thread] [--json]";
 
 /// --help: the usage line and what --positions does (errors print the usage line alone: one line).
 const char* kPositionsHelp =
@@ -49,6 +49,7 @@ struct Arguments {
   std::string deployCable;
   int deploySteps = 100;
   std::optional<double> deployTo;
+  bool oneThread = false;  ///< no second thread for a large model (the answer is the same)
 };
 
 /// The arguments, or how main must end without a model: --help printed (exit 0) or one error line (exit 2).
@@ -69,6 +70,8 @@ ParsedArguments parseArguments(int argc, char** argv) {
       a.json = true;
     } else if (arg == "--strict") {
       a.readOptions.strict = true;
+    } else if (arg == "--one-thread") {
+      a.oneThread = true;
     } else if (arg == "--lock-active-cables") {
       a.lockActiveCables = true;
     } else if (arg == "--deploy" || arg == "--steps" || arg == "--deploy-to") {
@@ -169,6 +172,7 @@ int main(int argc, char** argv) {
       }
     };
     options.lockActiveCables = a.lockActiveCables;
+    options.sideThreads = !a.oneThread;
     DeploymentOptions deployment;
     deployment.cable = a.deployCable;
     deployment.steps = a.deploySteps;
@@ -181,7 +185,7 @@ int main(int argc, char** argv) {
       return fail(diagnosticOf(analysis).toString());
     // The report is written only once its own invariants hold (finite numbers, consistent counts).
     const Result<std::string> out =
-        a.json ? writeJson(valueOf(analysis).report) : writeText(valueOf(analysis).report);
+        a.json ? writeJson(valueOf(analysis).report, !a.oneThread) : writeText(valueOf(analysis).report);
     if (!isOk(out))
       return fail(diagnosticOf(out).toString());
     std::cout << valueOf(out);

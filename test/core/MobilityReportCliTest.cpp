@@ -12,6 +12,8 @@
 #include "core/CliRun.hpp"
 #include "core/TestModels.hpp"
 #include "TextFile.hpp"
+#include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
+#include "mobility_analysis/generators/ScalingFamilies.hpp"
 
 using namespace mobility_analysis;
 
@@ -20,6 +22,21 @@ TEST(MobilityReportCli, JsonEqualsTheCoreReport) {
   const CliRun run = runReport(path + " --mode spatial --json");
   EXPECT_EQ(run.status, 0) << run.err;
   EXPECT_EQ(run.out, toJson(analyzeOrFail(path, AnalysisMode::Spatial).report));
+}
+
+TEST(MobilityReportCli, OneThreadGivesTheSameReport) {
+  // A model above the size where a second thread is used (a braced lattice of 2.3 10^4 equations): with
+  // --one-thread the analysis and the JSON stay on one thread, and the report is the same, byte for byte.
+  const GeneratorResult<std::string> urdf = toClosedLoopUrdf(makeBarLattice(32, 32, true));
+  ASSERT_TRUE(std::holds_alternative<std::string>(urdf));
+  const std::string path = ::testing::TempDir() + "braced_32_one_thread.urdf";
+  std::ofstream(path) << std::get<std::string>(urdf);
+  const CliRun two = runReport(path + " --json");
+  const CliRun one = runReport(path + " --one-thread --json");
+  EXPECT_EQ(two.status, 0) << two.err;
+  EXPECT_EQ(one.status, 0) << one.err;
+  EXPECT_GT(one.out.size(), 1000000u);
+  EXPECT_TRUE(one.out == two.out);
 }
 
 TEST(MobilityReportCli, PositionsAreUsed) {
