@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -71,8 +73,14 @@ class FindsAhead {
     slot.row = row;
     slot.traced = traced;
     published_.store(k + 1, std::memory_order_release);
-    if (!worker_.joinable())
-      worker_ = std::thread([this] { work(); });
+    if (!started_) {
+      started_ = true;
+      try {
+        worker_ = std::thread([this] { work(); });
+      } catch (const std::system_error&) {
+        // No thread to be had: the sweep finds every row itself, as on one thread.
+      }
+    }
     if (k % kWakeEvery == 0)
       wake_.notify_one();
   }
@@ -95,7 +103,14 @@ class FindsAhead {
       closed_ = true;
     }
     wake_.notify_one();
+    if (!worker_.joinable())
+      return;  // no worker: nothing to guess the state from, the sweep finds every row itself
+    // The back is found from the worker's latest state: wait until it has one (its first finds), or a
+    // regular structure's rows would all be found from the initial state and found again.
     const size_t count = published_.load(std::memory_order_relaxed);
+    while (doneFront_.load(std::memory_order_acquire) < std::min(count, kWarmUp) &&
+           !finished_.load(std::memory_order_acquire))
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
     for (size_t k = count; k-- > 0;) {
       Slot& slot = at(k);
       int expected = kFree;
@@ -116,6 +131,8 @@ class FindsAhead {
  private:
   static constexpr size_t kChunk = 4096;
   static constexpr size_t kWakeEvery = 64;
+  static constexpr size_t kWarmUp =
+      16;  ///< rows the worker finds before the sweep's thread guesses its state
   enum Status : int { kFree = 0, kFront = 1, kBack = 2, kDone = 3 };
 
   struct Slot {
@@ -152,9 +169,18 @@ class FindsAhead {
     }
   }
 
-  /// The worker: the published rows from the front, following the sweep's rule (sweepBasis) for which rows
-  /// it finds and from which state, with what it knows of the sweep's traces.
+  /// The worker; an exception (no memory) ends it, and the sweep finds what it left.
   void work() {
+    try {
+      findFromTheFront();
+    } catch (...) {
+    }
+    finished_.store(true, std::memory_order_release);
+  }
+
+  /// The published rows from the front, following the sweep's rule (sweepBasis) for which rows it finds and
+  /// from which state, with what it knows of the sweep's traces.
+  void findFromTheFront() {
     LocalStressFinder finder(mechanism_, model_, J_, order_, position_, tolerance_);
     int futile = 0;
     for (size_t k = 0;; ++k) {
@@ -194,6 +220,7 @@ class FindsAhead {
       }
       spaceFirst_.store(finder.inSpaceFirst(), std::memory_order_relaxed);
       slot.status.store(kDone, std::memory_order_release);
+      doneFront_.fetch_add(1, std::memory_order_release);
     }
   }
 
@@ -210,7 +237,10 @@ class FindsAhead {
   std::atomic<bool> stop_{false};
   std::atomic<bool> spaceFirst_{false};
   std::atomic<size_t> limitHint_{0};
-  bool closed_ = false;  ///< guarded by mutex_
+  std::atomic<size_t> doneFront_{0};
+  std::atomic<bool> finished_{false};
+  bool started_ = false;  ///< the sweep's thread only
+  bool closed_ = false;   ///< guarded by mutex_
   std::mutex mutex_;
   std::condition_variable wake_;
   std::mutex stateMutex_;
