@@ -58,11 +58,6 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
 
 namespace {
 
-/// From this many equations on, the passive-freedom search and the self-stress report run on a second thread
-/// beside the phases they do not depend on (core_detail::SideTask): about a millisecond of work, against tens
-/// of microseconds to start a thread.
-constexpr Eigen::Index kSideTaskEquations = 20000;
-
 /**
  * Idle groups' motions (Tsai): a rod spinning between two balls, a link sliding between parallel slides.
  * Where balls are written as three revolutes (Gepetto's way, analysis/CompositeBalls.hpp) the search runs on
@@ -113,7 +108,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   // The passive-freedom search reads the Jacobian and the pose only, and the self-stress report the basis
   // besides: on a large model each runs beside the phases that do not feed it (on a braced lattice the report
   // and the redundant links take about as long; on a chain the search and the self-stresses).
-  const bool sideTasks = options.sideThreads && J.rows() >= kSideTaskEquations;
+  const bool sideTasks = options.sideThreads && J.rows() >= core_detail::kSecondThreadEquations;
   core_detail::SideTask passiveTask(sideTasks,
                                     [&] { return findIdleMotions(mechanism, analysis.assembled, J); });
   // One elimination in sweep order finds a local basis of the self-stresses; the ordered answer, the loops

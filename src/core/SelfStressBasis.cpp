@@ -9,6 +9,7 @@
 
 #include "FindsAhead.hpp"
 #include "LocalStressFinder.hpp"
+#include "SideTask.hpp"
 #include "StressMatrix.hpp"
 
 namespace mobility_analysis {
@@ -34,10 +35,6 @@ constexpr size_t kFillFloor = 1000000;
 constexpr size_t kEchelonFillFactor = 2;
 constexpr size_t kEchelonRunningFactor = 8;
 constexpr size_t kEchelonFillFloor = 100000;
-
-/// From this many equations on, a sweep allowed a second thread has its local finds made ahead on it
-/// (FindsAhead.hpp): a thread costs tens of microseconds.
-constexpr Eigen::Index kFindAheadEquations = 20000;
 
 /// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
 constexpr double kStressNoise = 1e-10;
@@ -306,7 +303,7 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
                                        const SparseJacobian& J, double tolerance,
                                        const ProgressCallback& progress, size_t fillBudget, bool sideThread) {
   EliminationOrder order = computeSweepOrder(mechanism, model);
-  const bool findAhead = sideThread && J.rows() >= kFindAheadEquations;
+  const bool findAhead = sideThread && J.rows() >= core_detail::kSecondThreadEquations;
   // A tree (only tree joints carry equations) has no loop for a stress to close, but swept from the ground
   // every reduced row is written in the free coordinates of all the links above it: the fill, and the time,
   // grow as the square of its depth (a 2 10^5-link chain ran out of memory). Swept from the leaves instead,

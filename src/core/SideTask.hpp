@@ -11,6 +11,11 @@
 namespace mobility_analysis {
 namespace core_detail {
 
+/// From this many equations on, the analysis may use a second thread (the side tasks of the driver, the
+/// sweep's finds made ahead): about a millisecond of work, against tens of microseconds to start a thread,
+/// and the reference mechanisms and the node in motion stay below it.
+constexpr long kSecondThreadEquations = 20000;
+
 /**
  * A phase of the analysis that runs on a second thread beside the caller's work, or, when it is not worth a
  * thread, in the caller's thread when its result is asked for.

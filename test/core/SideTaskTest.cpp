@@ -25,8 +25,7 @@ Mechanism load(const MechanismDescription& description, const std::string& name)
   return valueOf(mechanism);
 }
 
-/// Side tasks start at this many equations (kSideTaskEquations in MobilityAnalysis.cpp).
-constexpr int kThreshold = 20000;
+constexpr long kThreshold = core_detail::kSecondThreadEquations;
 
 std::string reportOf(const Mechanism& mechanism, AnalysisMode mode, bool sideThreads) {
   AnalysisOptions options;
