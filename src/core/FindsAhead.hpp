@@ -42,15 +42,8 @@ class FindsAhead {
   };
 
   /// @param[in] maxRows most dependent rows the sweep can publish (J's rows).
-  FindsAhead(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J,
-             const EliminationOrder& order, const std::vector<int>& position, double tolerance,
-             int futileLimit, size_t maxRows)
-      : mechanism_(mechanism),
-        model_(model),
-        J_(J),
-        order_(order),
-        position_(position),
-        tolerance_(tolerance),
+  FindsAhead(const LocalStressFinder::Inputs& inputs, int futileLimit, size_t maxRows)
+      : inputs_(inputs),
         futileLimit_(futileLimit),
         chunks_(std::make_unique<std::unique_ptr<Slot[]>[]>(maxRows / kChunk + 1)) {}
 
@@ -181,7 +174,7 @@ class FindsAhead {
   /// The published rows from the front, following the sweep's rule (sweepBasis) for which rows it finds and
   /// from which state, with what it knows of the sweep's traces.
   void findFromTheFront() {
-    LocalStressFinder finder(mechanism_, model_, J_, order_, position_, tolerance_);
+    LocalStressFinder finder(inputs_);
     int futile = 0;
     for (size_t k = 0;; ++k) {
       if (k >= published_.load(std::memory_order_acquire)) {
@@ -224,12 +217,7 @@ class FindsAhead {
     }
   }
 
-  const Mechanism& mechanism_;
-  const CoordinateModel& model_;
-  const SparseJacobian& J_;
-  const EliminationOrder& order_;
-  const std::vector<int>& position_;
-  double tolerance_;
+  const LocalStressFinder::Inputs inputs_;
   int futileLimit_;
   /// Slots in chunks of kChunk, the chunk table sized for every row at once: a published slot never moves.
   std::unique_ptr<std::unique_ptr<Slot[]>[]> chunks_;

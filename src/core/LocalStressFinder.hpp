@@ -43,6 +43,17 @@ constexpr double kSpaceGrowth = 1.5;
  */
 class LocalStressFinder {
  public:
+  /// What a finder reads (all of it const while it lives): another thread's finder is made from the same.
+  struct Inputs {
+    const Mechanism& mechanism;
+    const CoordinateModel& model;
+    const SparseJacobian& J;
+    const EliminationOrder& order;
+    const std::vector<int>& position;
+    double tolerance;
+  };
+  explicit LocalStressFinder(const Inputs& in)
+      : LocalStressFinder(in.mechanism, in.model, in.J, in.order, in.position, in.tolerance) {}
   LocalStressFinder(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J,
                     const EliminationOrder& order, const std::vector<int>& position, double tolerance)
       : mechanism_(mechanism),

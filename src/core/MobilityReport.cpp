@@ -383,15 +383,13 @@ JsonParts::JsonParts(const MobilityReport& r) {
 
   fixed(1024, [&r](BufferedAppender& out) {
     out += "{\n";
-    appendField(out, "robot");
-    appendQuoted(out, r.robot);
-    out += ",\n";
-    appendField(out, "file");
-    appendQuoted(out, r.file);
-    out += ",\n";
-    appendField(out, "mode");
-    appendQuoted(out, r.mode);
-    out += ",\n";
+    const std::pair<const char*, const std::string*> names[] = {
+        {"robot", &r.robot}, {"file", &r.file}, {"mode", &r.mode}};
+    for (const auto& [name, text] : names) {
+      appendField(out, name);
+      appendQuoted(out, *text);
+      out += ",\n";
+    }
     const std::pair<const char*, int> counts[] = {{"lambda", r.lambda},
                                                   {"dof", r.dof},
                                                   {"grubler_kutzbach_dof", r.grublerKutzbachDof},
@@ -408,12 +406,12 @@ JsonParts::JsonParts(const MobilityReport& r) {
     appendField(out, "singular");
     appendBoolean(out, r.singular);
     out += ",\n";
-    appendField(out, "passive_dof");
-    appendInteger(out, r.passiveDof);
-    out += ",\n";
-    appendField(out, "output_dof");
-    appendInteger(out, r.outputDof);
-    out += ",\n";
+    for (const auto& [name, value] : {std::pair<const char*, int>{"passive_dof", r.passiveDof},
+                                      std::pair<const char*, int>{"output_dof", r.outputDof}}) {
+      appendField(out, name);
+      appendInteger(out, value);
+      out += ",\n";
+    }
     appendField(out, "passive_motions");
     appendList(out, r.passiveMotions, [&](const PassiveMotion& m) {
       out += "{\"links\": ";

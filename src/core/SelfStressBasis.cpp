@@ -149,7 +149,8 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
     }
     if (findAhead) {
       if (!ahead)
-        ahead.emplace(mechanism, model, J, order, position, tolerance, kFutileFinds, static_cast<size_t>(m));
+        ahead.emplace(LocalStressFinder::Inputs{mechanism, model, J, order, position, tolerance},
+                      kFutileFinds, static_cast<size_t>(m));
       Passed row{r, elimination.rank(), 0, std::nullopt};
       if (!ahead->predictsSpaceFirst()) {
         row.limit = ahead->traceLimitHint(traceLimit);
