@@ -26,6 +26,10 @@ void computeConstraintResidual(const CoordinateModel& model, const Eigen::Ref<co
  * "Comparison of coordinates"); each equation writes only its own few columns.
  */
 SparseJacobian computeConstraintJacobian(const CoordinateModel& model, const Eigen::Ref<const Eigen::VectorXd>& q);
+/// computeConstraintJacobian, its second half of rows written on a second thread when @p sideThread and the
+/// model is large (from 2 10^4 equations); the matrix is the same.
+SparseJacobian computeConstraintJacobian(const CoordinateModel& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                         bool sideThread);
 
 /**
  * @brief The Hessian of equation @p row, \f$ \partial^2 \Phi_{row} / \partial q^2 \f$ at q (dense,

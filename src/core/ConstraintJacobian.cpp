@@ -5,6 +5,8 @@
 
 #include "mobility_analysis/coordinates/EquationForms.hpp"
 
+#include "SideTask.hpp"
+
 namespace mobility_analysis {
 
 // Each function below is a dispatcher: the form types of EquationForms.hpp own the algebra.
@@ -21,7 +23,8 @@ void computeConstraintResidual(const CoordinateModel& model, const Eigen::Ref<co
 
 namespace {
 
-/// The rows of a sparse matrix written one after another: column indices and values, and where each row starts.
+/// The rows of a sparse matrix written one after another: column indices and values, and where each row
+/// starts.
 struct RowsWritten {
   std::vector<int> columns;
   std::vector<double> values;
@@ -57,32 +60,65 @@ void appendRow(GradientSink& entries, RowsWritten& rows) {
   rows.rowStart.push_back(static_cast<int>(rows.columns.size()));
 }
 
-/// @p rows as a compressed row-major matrix with @p numColumns columns, its storage of the exact size.
-SparseJacobian toMatrix(const RowsWritten& rows, int numColumns) {
-  SparseJacobian matrix(static_cast<Eigen::Index>(rows.rowStart.size()) - 1, numColumns);
-  matrix.resizeNonZeros(static_cast<Eigen::Index>(rows.columns.size()));
-  std::copy(rows.rowStart.begin(), rows.rowStart.end(), matrix.outerIndexPtr());
-  std::copy(rows.columns.begin(), rows.columns.end(), matrix.innerIndexPtr());
-  std::copy(rows.values.begin(), rows.values.end(), matrix.valuePtr());
+/// @p parts, one after another, as a compressed row-major matrix with @p numColumns columns, its storage of
+/// the exact size.
+SparseJacobian toMatrix(const std::vector<const RowsWritten*>& parts, int numColumns) {
+  size_t numRows = 0, numEntries = 0;
+  for (const RowsWritten* rows : parts) {
+    numRows += rows->rowStart.size() - 1;
+    numEntries += rows->columns.size();
+  }
+  SparseJacobian matrix(static_cast<Eigen::Index>(numRows), numColumns);
+  matrix.resizeNonZeros(static_cast<Eigen::Index>(numEntries));
+  int* rowStart = matrix.outerIndexPtr();
+  int offset = 0;
+  size_t row = 0;
+  for (const RowsWritten* rows : parts) {
+    for (size_t r = 0; r + 1 < rows->rowStart.size(); ++r)
+      rowStart[row++] = offset + rows->rowStart[r];
+    std::copy(rows->columns.begin(), rows->columns.end(), matrix.innerIndexPtr() + offset);
+    std::copy(rows->values.begin(), rows->values.end(), matrix.valuePtr() + offset);
+    offset += static_cast<int>(rows->columns.size());
+  }
+  rowStart[row] = offset;
   return matrix;
+}
+
+/// The rows [@p first, @p last) of the Jacobian, written in order, each from its own equation's few entries.
+RowsWritten writeRows(const CoordinateModel& model, const ElementView& view, int first, int last) {
+  RowsWritten rows;
+  rows.rowStart.reserve(static_cast<size_t>(last - first) + 1);
+  GradientSink entries;
+  for (int i = first; i < last; ++i) {
+    const ConstraintEquation& eq = model.equations[i];
+    entries.clear();
+    visitForm(eq.form, [&](auto form) { form.gradient(view, eq, i, entries); });
+    appendRow(entries, rows);
+  }
+  return rows;
 }
 
 }  // namespace
 
 SparseJacobian computeConstraintJacobian(const CoordinateModel& model,
                                          const Eigen::Ref<const Eigen::VectorXd>& q) {
+  return computeConstraintJacobian(model, q, false);
+}
+
+SparseJacobian computeConstraintJacobian(const CoordinateModel& model,
+                                         const Eigen::Ref<const Eigen::VectorXd>& q, bool sideThread) {
   const ElementView view(model, q);
-  // The rows are written in order, each from its own equation's few entries.
-  RowsWritten rows;
-  rows.rowStart.reserve(static_cast<size_t>(model.numConstraints()) + 1);
-  GradientSink entries;
-  for (int i = 0; i < model.numConstraints(); ++i) {
-    const ConstraintEquation& eq = model.equations[i];
-    entries.clear();
-    visitForm(eq.form, [&](auto form) { form.gradient(view, eq, i, entries); });
-    appendRow(entries, rows);
+  const int m = model.numConstraints();
+  if (!sideThread || m < core_detail::kSecondThreadEquations) {
+    const RowsWritten rows = writeRows(model, view, 0, m);
+    return toMatrix({&rows}, model.numCoordinates());
   }
-  return toMatrix(rows, model.numCoordinates());
+  // Each row is its own equation's alone: the second half on another thread, then both copied into place.
+  const int half = m / 2;
+  core_detail::SideTask second(true, [&] { return writeRows(model, view, half, m); });
+  const RowsWritten first = writeRows(model, view, 0, half);
+  const RowsWritten rest = second.get();
+  return toMatrix({&first, &rest}, model.numCoordinates());
 }
 
 Eigen::MatrixXd computeEquationHessian(const CoordinateModel& model,

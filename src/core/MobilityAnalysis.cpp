@@ -103,20 +103,20 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   const CoordinateModel& model = analysis.assembled.model;
 
   progress("jacobian", 0.2);
-  const SparseJacobian J = computeConstraintJacobian(model, analysis.assembled.q);
+  const bool sideTasks = options.sideThreads && model.numConstraints() >= core_detail::kSecondThreadEquations;
+  const SparseJacobian J = computeConstraintJacobian(model, analysis.assembled.q, sideTasks);
   const double tolerance = options.rankTolerance > 0.0 ? options.rankTolerance : tolerances::kRank;
   // The passive-freedom search reads the Jacobian and the pose only, and the self-stress report the basis
   // besides: on a large model each runs beside the phases that do not feed it (on a braced lattice the report
   // and the redundant links take about as long; on a chain the search and the self-stresses).
-  const bool sideTasks = options.sideThreads && J.rows() >= core_detail::kSecondThreadEquations;
   core_detail::SideTask passiveTask(sideTasks,
                                     [&] { return findIdleMotions(mechanism, analysis.assembled, J); });
   // One elimination in sweep order finds a local basis of the self-stresses; the ordered answer, the loops
   // and the redundant links are all read off it (SelfStressBasis.hpp, RedundantLinks.hpp).
   progress("self-stresses", 0.3);
   const SelfStressBasis basis = computeSelfStressBasis(
-      mechanism, model, J, tolerance, [&](double fraction) { progress("self-stresses", 0.3 + 0.5 * fraction); },
-      0, sideTasks);
+      mechanism, model, J, tolerance,
+      [&](double fraction) { progress("self-stresses", 0.3 + 0.5 * fraction); }, 0, sideTasks);
   core_detail::SideTask stressReportTask(
       sideTasks, [&] { return computeSelfStressInfo(mechanism, model, analysis.assembled.q, J, basis); });
   progress("ordered redundancy", 0.8);

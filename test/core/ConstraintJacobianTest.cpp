@@ -201,3 +201,22 @@ TEST(ConstraintJacobian, HessiansMatchFiniteDifferencesForEveryForm) {
   EXPECT_FALSE(hasConstantHessian(EquationForm::Triple));
   EXPECT_TRUE(hasConstantHessian(EquationForm::Combination));
 }
+
+TEST(ConstraintJacobian, HalvesOnTwoThreadsGiveTheSameMatrix) {
+  // From 2 10^4 equations the analysis writes the second half of the rows on a second thread: the matrix
+  // must be the one-thread matrix, index for index and bit for bit (a chain in the plane and in space).
+  Result<Mechanism> mechanism = loadMechanismFromString(straightChainUrdf(6000), "chain.urdf");
+  ASSERT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+  for (AnalysisMode mode : {AnalysisMode::Planar, AnalysisMode::Spatial}) {
+    const ModelAtTreePose m = assembleAtTreePose(valueOf(mechanism), mode);
+    ASSERT_GE(m.J.rows(), 20000);
+    const SparseJacobian one = computeConstraintJacobian(m.assembled.model, m.assembled.q, false);
+    const SparseJacobian two = computeConstraintJacobian(m.assembled.model, m.assembled.q, true);
+    ASSERT_EQ(one.rows(), two.rows());
+    ASSERT_EQ(one.nonZeros(), two.nonZeros());
+    EXPECT_TRUE(std::equal(one.outerIndexPtr(), one.outerIndexPtr() + one.rows() + 1, two.outerIndexPtr()));
+    EXPECT_TRUE(std::equal(one.innerIndexPtr(), one.innerIndexPtr() + one.nonZeros(), two.innerIndexPtr()));
+    EXPECT_TRUE(std::equal(one.valuePtr(), one.valuePtr() + one.nonZeros(), two.valuePtr()));
+    EXPECT_TRUE(std::equal(one.valuePtr(), one.valuePtr() + one.nonZeros(), m.J.valuePtr()));
+  }
+}
