@@ -43,6 +43,26 @@ class NameIndex {
     return -1;
   }
 
+  /**
+   * @brief The index of @p name among @p items, as find gives it; when it has none, @p name is given @p index
+   *        and -1 returned: find and insert with one hash and one probe sequence.
+   * @note @p index must stand for items[index] before the next find meets it (the caller appends it next).
+   */
+  template <class Item>
+  int findOrInsert(std::string_view name, int index, const std::vector<Item>& items) {
+    if (2 * (count_ + 1) > slots_.size())
+      rehash(slots_.empty() ? 16 : 2 * slots_.size());
+    const uint32_t hash = hashOf(name);
+    size_t s = hash & mask();
+    for (; slots_[s].index >= 0; s = (s + 1) & mask()) {
+      if (slots_[s].hash == hash && items[slots_[s].index].name == name)
+        return slots_[s].index;
+    }
+    slots_[s] = Slot{hash, index};
+    ++count_;
+    return -1;
+  }
+
   /// Gives @p name the index @p index; @p name must not have one yet (find first).
   void insert(std::string_view name, int index) {
     if (2 * (count_ + 1) > slots_.size())
