@@ -151,7 +151,13 @@ TEST(UrdfLoader, aNumberTripleIsThreeBlankSeparatedFiniteNumbersAndNothingElse) 
     std::string fragment;   // of the diagnostic, else
   };
   const std::vector<Case> cases = {
-      {"1 2 3", {1, 2, 3}, ""},
+      {"1 2 3",
+       {1, 2, 3},
+       ""},  // three single digits: the reader's short cut, and next to it the general loop
+      {"1 2 34", {1, 2, 34}, ""},
+      {"7 8 9 ", {7, 8, 9}, ""},
+      {"1 2 ", {}, "needs 3 numbers, got 2: '1 2 '"},
+      {"1 2 3 x", {}, "has more than 3 numbers: '1 2 3 x'"},
       {"\t-1.5\n2e-3   +3 ", {-1.5, 2e-3, 3}, ""},  // every blank separates, leading and trailing ones too
       {"\r\n 0x10 0 .5\f", {16, 0, 0.5}, ""},       // strtod's forms, as before
       {"1 2", {}, "needs 3 numbers, got 2: '1 2'"},

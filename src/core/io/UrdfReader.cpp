@@ -58,12 +58,14 @@ Element nextSiblingElement(Element e) {
 template <size_t N>
 std::array<Element, N> childrenNamed(Element e, const std::array<const char*, N>& tags) {
   std::array<Element, N> found{};
+  unsigned seen = 0;  // bit i: found[i] set (a bit test, not a call into pugixml)
   for (Element c = e.first_child(); c; c = c.next_sibling()) {
     const char* name = c.name();  // "" for text
     for (size_t i = 0; i < N; ++i) {
       if (name[0] == tags[i][0] && std::strcmp(name, tags[i]) == 0) {
-        if (!found[i])
+        if ((seen & (1u << i)) == 0)
           found[i] = c;
+        seen |= 1u << i;
         break;
       }
     }
@@ -118,7 +120,8 @@ constexpr std::array<const char*, 7> kKnownSorted = {"cable", "coupling", "dista
 
 /// Blanks as `std::istream >> std::string` splits on them (the "C" locale's isspace).
 bool isBlank(char c) {
-  return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r';
+  // '\t' '\n' '\v' '\f' '\r' are 9 to 13: one unsigned range test for the five.
+  return c == ' ' || static_cast<unsigned char>(c - '\t') <= '\r' - '\t';
 }
 
 /// @return @p name lower-cased without '_', '-' and ':', so a misspelt `<loopjoint>` can be pointed at.
@@ -252,6 +255,12 @@ class Reader {
                          Label attribute) const {
     if (text == nullptr)
       return Eigen::Vector3d::Zero();
+    // "d d d" of three single digits (rpy="0 0 0", xyz="0 0 1": most triples of a URDF) is the three digits,
+    // what the loop below reads from it, without its scan (each test reads only within the text).
+    auto digit = [](char c) { return static_cast<unsigned char>(c - '0') <= 9; };
+    if (digit(text[0]) && text[1] == ' ' && digit(text[2]) && text[3] == ' ' && digit(text[4]) &&
+        text[5] == '\0')
+      return Eigen::Vector3d(text[0] - '0', text[2] - '0', text[4] - '0');
     Eigen::Vector3d v;
     int count = 0;
     const char* at = text;
