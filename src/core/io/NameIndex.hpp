@@ -7,6 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "HugePages.hpp"
+
 namespace mobility_analysis {
 namespace io_detail {
 
@@ -77,8 +79,16 @@ class NameIndex {
     int index = -1;  ///< -1: empty
   };
 
+  /// The hash of @p name without its last character, plus that character: names numbered in order
+  /// ("link_17", "link_18") take neighbouring slots, so a file's names, given and looked up mostly in the
+  /// order they are numbered, share cache lines instead of each probe missing the cache (the table is
+  /// megabytes for 10^5 names). The slot's stored hash still tells such names apart.
   static uint32_t hashOf(std::string_view name) {
-    return static_cast<uint32_t>(std::hash<std::string_view>()(name));
+    if (name.empty())
+      return 0;
+    const std::string_view stem = name.substr(0, name.size() - 1);
+    return static_cast<uint32_t>(std::hash<std::string_view>()(stem)) +
+           static_cast<unsigned char>(name.back());
   }
   size_t mask() const { return slots_.size() - 1; }
 
@@ -90,7 +100,12 @@ class NameIndex {
   }
 
   void rehash(size_t capacity) {
-    std::vector<Slot> old(capacity);
+    // Reserved, advised, then filled: probes land anywhere in the table (megabytes for 10^5 names), and on
+    // 4 KiB pages nearly each one missed the TLB as well as the cache.
+    std::vector<Slot> old;
+    old.reserve(capacity);
+    adviseHugePages(old.data(), capacity * sizeof(Slot));
+    old.resize(capacity);
     old.swap(slots_);
     for (const Slot& slot : old) {
       if (slot.index >= 0)
