@@ -151,9 +151,8 @@ TEST(UrdfLoader, aNumberTripleIsThreeBlankSeparatedFiniteNumbersAndNothingElse) 
     std::string fragment;   // of the diagnostic, else
   };
   const std::vector<Case> cases = {
-      {"1 2 3",
-       {1, 2, 3},
-       ""},  // three single digits: the reader's short cut, and next to it the general loop
+      // Three single digits: the reader's short cut; next to it, the general loop.
+      {"1 2 3", {1, 2, 3}, ""},
       {"1 2 34", {1, 2, 34}, ""},
       {"7 8 9 ", {7, 8, 9}, ""},
       {"1 2 ", {}, "needs 3 numbers, got 2: '1 2 '"},

@@ -41,14 +41,20 @@ void forEachLength(const Mechanism& mechanism, const Visit& visit) {
   }
 }
 
-double medianOfNonzero(const Mechanism& mechanism) {
+/// The lower median of the nonzero lengths of @p mechanism (0 when there is none); @p longest (if given): the
+/// longest of all its lengths (0 when there is none).
+double medianOfNonzero(const Mechanism& mechanism, double* longest = nullptr) {
   std::vector<double> values;
   values.reserve(3 * mechanism.joints.size());  // at most three lengths a connection (a cable)
+  double maximum = 0.0;
   forEachLength(mechanism, [&](double value, int, const char*) {
     if (value > tolerances::kZeroVector && std::isfinite(value))  // CAD round-off (1e-17) is zero
       values.push_back(value);
+    maximum = std::max(maximum, value);
     return false;
   });
+  if (longest != nullptr)
+    *longest = maximum;
   if (values.empty())
     return 0.0;
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>((values.size() - 1) / 2);  // lower median
@@ -63,10 +69,13 @@ double typicalLength(const Mechanism& mechanism) {
 }
 
 std::optional<Diagnostic> checkLengthRange(const Mechanism& mechanism) {
-  const double typical = medianOfNonzero(mechanism);
+  double longest = 0.0;
+  const double typical = medianOfNonzero(mechanism, &longest);
   if (typical <= 0.0)
     return std::nullopt;
   const double limit = tolerances::kMaxRelativeLength * typical;
+  if (longest <= limit)
+    return std::nullopt;  // every length within range: no second walk to find the first that is not
   std::optional<Diagnostic> outOfRange;
   forEachLength(mechanism, [&](double value, int index, const char* what) {
     if (value <= limit)
