@@ -151,7 +151,12 @@ TEST(UrdfLoader, aNumberTripleIsThreeBlankSeparatedFiniteNumbersAndNothingElse) 
     std::string fragment;   // of the diagnostic, else
   };
   const std::vector<Case> cases = {
+      // Three single digits: the reader's short cut; next to it, the general loop.
       {"1 2 3", {1, 2, 3}, ""},
+      {"1 2 34", {1, 2, 34}, ""},
+      {"7 8 9 ", {7, 8, 9}, ""},
+      {"1 2 ", {}, "needs 3 numbers, got 2: '1 2 '"},
+      {"1 2 3 x", {}, "has more than 3 numbers: '1 2 3 x'"},
       {"\t-1.5\n2e-3   +3 ", {-1.5, 2e-3, 3}, ""},  // every blank separates, leading and trailing ones too
       {"\r\n 0x10 0 .5\f", {16, 0, 0.5}, ""},       // strtod's forms, as before
       {"1 2", {}, "needs 3 numbers, got 2: '1 2'"},
@@ -317,6 +322,23 @@ TEST(NameIndex, findsEveryNameGivenThroughGrowthAndNoOther) {
   EXPECT_EQ(index.find("n5002x", items), -1);
 }
 
+TEST(NameIndex, findOrInsertGivesTheIndexOfANameGivenAndClaimsANewOne) {
+  struct Named {
+    std::string name;
+  };
+  std::vector<Named> items;
+  io_detail::NameIndex index;  // no reserve: it grows from empty, between a claim and its append too
+  for (int i = 0; i < 5000; ++i) {
+    const std::string name = "n" + std::to_string(i * 31 % 5003);
+    ASSERT_EQ(index.findOrInsert(name, i, items), -1);  // claimed for the item appended next
+    items.push_back(Named{name});
+    ASSERT_EQ(index.findOrInsert(name, -7, items), i);  // given: found, nothing inserted
+  }
+  for (int i = 0; i < 5000; ++i)
+    EXPECT_EQ(index.find(items[i].name, items), i);
+  EXPECT_EQ(index.find("n5002x", items), -1);
+}
+
 TEST(ReadMechanism, theFormatIsToldByTheRootHoweverLongTheProlog) {
   // The root element is looked for in the file's head (64 KiB) and in the whole file when the head ends
   // before it, or inside its name: a URDF and an SDF behind a long comment, with the name cut at every spot
@@ -417,6 +439,17 @@ TEST(UrdfLoader, whatIsNotWellFormedXmlIsRefusedAndTextIsReadAsWritten) {
       {"<robot name=\"r\">\n" + tree +
            "\n<link name=\"c\"><visual><box size=\"1\" size=\"2\"/></visual></link></robot>",
        "attribute 'size' given twice in <box> at line 3"},
+      {"<robot name=\"r\">" + tree + "<link name=\"c\"><box a=\"1\" b=\"2\" a=\"3\"/></link></robot>",
+       "attribute 'a' given twice in <box>"},
+      // Past the eight names gathered: the ninth and later are compared through pugixml.
+      {"<robot name=\"r\">" + tree +
+           "<link name=\"c\"><box a1=\"\" a2=\"\" a3=\"\" a4=\"\" a5=\"\" a6=\"\" a7=\"\" a8=\"\" a9=\"\" "
+           "a10=\"\" a9=\"\"/></link></robot>",
+       "attribute 'a9' given twice in <box>"},
+      {"<robot name=\"r\">" + tree +
+           "<link name=\"c\"><box a1=\"\" a2=\"\" a3=\"\" a4=\"\" a5=\"\" a6=\"\" a7=\"\" a8=\"\" a9=\"\" "
+           "a2=\"\"/></link></robot>",
+       "attribute 'a2' given twice in <box>"},
       {"<robot name=\"r\" x=\"1\"y=\"2\">" + tree + "</robot>", "not well-formed XML"},
       {"<robot name=\"r\">" + tree + "</robot></robot>", "not well-formed XML"},
       {"<robot name=\"r\">\n" + tree + "\n", "not well-formed XML"},

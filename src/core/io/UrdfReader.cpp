@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <initializer_list>
@@ -11,6 +12,7 @@
 
 #include <pugixml.hpp>
 
+#include "HugePages.hpp"
 #include "NameIndex.hpp"
 #include "XmlValues.hpp"
 #include "mobility_analysis/Tolerances.hpp"
@@ -56,12 +58,14 @@ Element nextSiblingElement(Element e) {
 template <size_t N>
 std::array<Element, N> childrenNamed(Element e, const std::array<const char*, N>& tags) {
   std::array<Element, N> found{};
+  unsigned seen = 0;  // bit i: found[i] set (a bit test, not a call into pugixml)
   for (Element c = e.first_child(); c; c = c.next_sibling()) {
     const char* name = c.name();  // "" for text
     for (size_t i = 0; i < N; ++i) {
       if (name[0] == tags[i][0] && std::strcmp(name, tags[i]) == 0) {
-        if (!found[i])
+        if ((seen & (1u << i)) == 0)
           found[i] = c;
+        seen |= 1u << i;
         break;
       }
     }
@@ -116,7 +120,8 @@ constexpr std::array<const char*, 7> kKnownSorted = {"cable", "coupling", "dista
 
 /// Blanks as `std::istream >> std::string` splits on them (the "C" locale's isspace).
 bool isBlank(char c) {
-  return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r';
+  // '\t' '\n' '\v' '\f' '\r' are 9 to 13: one unsigned range test for the five.
+  return c == ' ' || static_cast<unsigned char>(c - '\t') <= '\r' - '\t';
 }
 
 /// @return @p name lower-cased without '_', '-' and ':', so a misspelt `<loopjoint>` can be pointed at.
@@ -134,7 +139,8 @@ const char* loopTypeList = "revolute, continuous, prismatic, cylindrical, spheri
 /// The type spelled @p type among @p allowed, by the dialect's spelling (toString(JointType)).
 std::optional<JointType> parseJointType(std::string_view type, std::initializer_list<JointType> allowed) {
   for (const JointType candidate : allowed) {
-    if (type == toString(candidate))
+    const char* spelling = toString(candidate);
+    if (!type.empty() && type[0] == spelling[0] && type == spelling)  // the first letter tells most apart
       return candidate;
   }
   return std::nullopt;
@@ -196,6 +202,7 @@ class Reader {
     for (int kind = kJoint; kind < kIgnored; ++kind)
       connections += byKind[kind].size();
     mechanism_.joints.reserve(connections);
+    io_detail::adviseHugePages(mechanism_.joints.data(), connections * sizeof(Joint));
     connectionIndex_.reserve(connections);
     readLinks(byKind[kLink]);
     readTreeJoints(byKind[kJoint]);
@@ -248,6 +255,12 @@ class Reader {
                          Label attribute) const {
     if (text == nullptr)
       return Eigen::Vector3d::Zero();
+    // "d d d" of three single digits (rpy="0 0 0", xyz="0 0 1": most triples of a URDF) is the three digits,
+    // what the loop below reads from it, without its scan (each test reads only within the text).
+    auto digit = [](char c) { return static_cast<unsigned char>(c - '0') <= 9; };
+    if (digit(text[0]) && text[1] == ' ' && digit(text[2]) && text[3] == ' ' && digit(text[4]) &&
+        text[5] == '\0')
+      return Eigen::Vector3d(text[0] - '0', text[2] - '0', text[4] - '0');
     Eigen::Vector3d v;
     int count = 0;
     const char* at = text;
@@ -269,8 +282,11 @@ class Reader {
             kind, name,
             attribute.str() + " '" + text + "' is not a number triple ('" + std::string(at, tokenEnd) + "')");
       }
-      if (const std::optional<std::string> why = checkRange(*value))
-        fail(kind, name, attribute.str() + " '" + text + "' " + *why);
+      // The range test inline (false for NaN too), checkRange only for its reason: most numbers pass it.
+      if (!(std::abs(*value) <= tolerances::kMaxCoordinate)) {
+        if (const std::optional<std::string> why = checkRange(*value))
+          fail(kind, name, attribute.str() + " '" + text + "' " + *why);
+      }
       v[count++] = *value;
       at = tokenEnd;
     }
@@ -325,7 +341,8 @@ class Reader {
     const std::vector<Link>& links = mechanism_.links;
     const std::string_view key(name);  // its length once; a guess of another length costs one comparison
     for (const int guess : {lastLink_ + 1, lastLink_}) {
-      if (guess >= 0 && guess < static_cast<int>(links.size()) && links[static_cast<size_t>(guess)].name == key)
+      if (guess >= 0 && guess < static_cast<int>(links.size()) &&
+          links[static_cast<size_t>(guess)].name == key)
         return lastLink_ = guess;
     }
     const int index = linkIndex_.find(key, links);
@@ -372,10 +389,10 @@ class Reader {
       const char* name = attributeOf(e, "name");
       if (name == nullptr || *name == '\0')
         fail("link", "", "has no name");
-      if (linkIndex_.find(name, mechanism_.links) >= 0)
+      const std::string_view key(name);  // its length once, for the index and the copy
+      if (linkIndex_.findOrInsert(key, static_cast<int>(mechanism_.links.size()), mechanism_.links) >= 0)
         fail("link", name, "is defined twice");
-      linkIndex_.insert(name, static_cast<int>(mechanism_.links.size()));
-      mechanism_.links.push_back(Link{std::string(name)});
+      mechanism_.links.push_back(Link{std::string(key)});
     }
     if (mechanism_.links.empty())
       fail("robot", mechanism_.name, "has no <link>");
@@ -387,6 +404,17 @@ class Reader {
       fail(kind, name, kind == "joint" ? "is defined twice" : "has the name of another joint or constraint");
   }
 
+  /// Refuses @p name as claimName does, else gives it the index of the connection appended next (by
+  /// appendClaimed or in place): one probe of the index for claimName's and addConnection's two.
+  void claimNextName(std::string_view kind, const std::string& name) {
+    if (connectionIndex_.findOrInsert(name, static_cast<int>(mechanism_.joints.size()), mechanism_.joints) >=
+        0)
+      fail(kind, name, kind == "joint" ? "is defined twice" : "has the name of another joint or constraint");
+  }
+
+  /// Appends @p joint, whose name claimNextName gave its index, to the mechanism's connections.
+  void appendClaimed(Joint&& joint) { mechanism_.joints.push_back(std::move(joint)); }
+
   /// Appends @p joint to the mechanism's connections, and its name to their index.
   void addConnection(Joint&& joint) {
     connectionIndex_.insert(joint.name, static_cast<int>(mechanism_.joints.size()));
@@ -397,7 +425,7 @@ class Reader {
     parentOf_.assign(mechanism_.links.size(), -1);
     for (Element e : elements) {
       std::string name = elementName(e, "joint");
-      claimName("joint", name);
+      claimNextName("joint", name);  // the joint is written in place below, or the whole read fails
       const auto [parent, child, origin, axisElement, mimic] =
           childrenNamed<5>(e, {"parent", "child", "origin", "axis", "mimic"});
       const char* parentName = parent ? attributeOf(parent, "link") : nullptr;
@@ -460,7 +488,6 @@ class Reader {
       }
       parentOf_[childLink] = parentLink;
       joint.name = std::move(name);
-      connectionIndex_.insert(joint.name, static_cast<int>(mechanism_.joints.size()) - 1);
     }
   }
 
@@ -525,7 +552,7 @@ class Reader {
     const std::string kindName = toString(kind);
     Joint joint;
     joint.name = elementName(e, kindName);
-    claimName(kindName, joint.name);
+    claimNextName(kindName, joint.name);
     joint.kind = kind;
     joint.type = JointType::Spherical;
     checkChildren(e, kindName, joint.name, {"link1", "link2"});
@@ -540,7 +567,7 @@ class Reader {
         fail("cable", joint.name, "length must be positive, got " + std::string(attributeOf(e, "length")));
     }
     readEnds(e, "link1", "link2", kindName, joint);
-    addConnection(std::move(joint));
+    appendClaimed(std::move(joint));
   }
 
   /// <loop_joint> of our dialect (Isaac Sim, Drake) or URDF+ <loop>: the same connection, two spellings.
@@ -549,7 +576,7 @@ class Reader {
     const bool urdfPlus = kind == "loop";
     Joint joint;
     joint.name = elementName(e, kind);
-    claimName(kind, joint.name);
+    claimNextName(kind, joint.name);
     joint.kind = ConnectionKind::LoopJoint;
     const char* type = attributeOf(e, "type");
     const std::optional<JointType> loopType = parseLoopType(type == nullptr ? "" : type);
@@ -576,7 +603,7 @@ class Reader {
     joint.axis2 = axis(axis2Element, "axis2", kind, joint.name, Eigen::Vector3d::UnitY());
     if (joint.type == JointType::Universal && joint.axis.cross(joint.axis2).norm() < tolerances::kPlanarAxis)
       fail(kind, joint.name, "universal joint axes 'axis' and 'axis2' are parallel");
-    addConnection(std::move(joint));
+    appendClaimed(std::move(joint));
   }
 
   /// URDF+ <coupling>: successor = ratio * predecessor + offset.
@@ -672,34 +699,38 @@ struct XmlFault {
   ptrdiff_t offset = -1;  ///< Into the text as written; -1: unknown.
 };
 
-/// The first attribute of @p e named like an earlier one of @p e, or a null attribute. Most elements have one
-/// or two attributes: their names are gathered once and compared there (pugixml's accessors are calls into
-/// the shared library).
-pugi::xml_attribute repeatedAttribute(Element e) {
-  pugi::xml_attribute a = e.first_attribute();
-  if (!a || !a.next_attribute())
-    return pugi::xml_attribute();
+/// The name of the first attribute of @p e named like an earlier one of @p e, or nullptr. Most elements have
+/// one or two attributes: their names are gathered once and compared there (pugixml's accessors are calls
+/// into the shared library).
+const char* repeatedAttribute(Element e) {
+  // A null attribute's name is "" and a parsed one's never is (pugixml refuses an attribute without a
+  // name): the names end the walk, one call an attribute fewer than a test of each handle.
+  const pugi::xml_attribute first = e.first_attribute();
+  pugi::xml_attribute a = first.next_attribute();  // null too when there is no first (and for non-elements)
+  const char* name = a.name();
+  if (*name == '\0')
+    return nullptr;  // fewer than two attributes
   constexpr int kGathered = 8;
   const char* names[kGathered];
-  int count = 0;
-  for (; a; a = a.next_attribute()) {
-    const char* name = a.name();
+  names[0] = first.name();
+  int count = 1;
+  for (; *name != '\0'; a = a.next_attribute(), name = a.name()) {
     const int earlier = std::min(count, kGathered);
     for (int i = 0; i < earlier; ++i) {
       if (names[i][0] == name[0] && std::strcmp(names[i], name) == 0)
-        return a;
+        return name;
     }
     if (count >= kGathered) {  // beyond the gathered names: through pugixml
-      for (pugi::xml_attribute b = e.first_attribute(); b != a; b = b.next_attribute()) {
+      for (pugi::xml_attribute b = first; b != a; b = b.next_attribute()) {
         if (std::strcmp(b.name(), name) == 0)
-          return a;
+          return name;
       }
     } else {
       names[count] = name;
     }
     ++count;
   }
-  return pugi::xml_attribute();
+  return nullptr;
 }
 
 /**
@@ -721,13 +752,12 @@ std::optional<XmlFault> wellFormedError(const pugi::xml_document& document) {
   struct RepeatedAttributes : pugi::xml_tree_walker {
     std::optional<XmlFault> fault;
     bool for_each(pugi::xml_node& node) override {
-      const pugi::xml_attribute repeated = repeatedAttribute(node);  // null but for elements
-      if (repeated) {
-        fault =
-            XmlFault{"attribute '" + std::string(repeated.name()) + "' given twice in <" + node.name() + ">",
-                     node.offset_debug()};
+      const char* repeated = repeatedAttribute(node);  // nullptr but for elements
+      if (repeated != nullptr) {
+        fault = XmlFault{"attribute '" + std::string(repeated) + "' given twice in <" + node.name() + ">",
+                         node.offset_debug()};
       }
-      return !repeated;
+      return repeated == nullptr;
     }
   } walker;
   Element root = document.root();  // a handle: traverse is not const, but does not change the tree

@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include "HugePages.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
@@ -144,6 +145,8 @@ inline bool readWholeFile(const std::string& path, std::string& text) {
   if (::fstat(::fileno(file), &status) == 0 && S_ISREG(status.st_mode) && status.st_size > 0)
     size = static_cast<size_t>(status.st_size);
   text.clear();
+  text.reserve(size + 1);
+  adviseHugePages(text.data(), text.capacity());
   size_t used = 0;
   bool ok = true;
   while (true) {
