@@ -51,6 +51,7 @@
 #endif
 
 #include "mobility_analysis/analysis/FiniteMobility.hpp"
+#include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
 #include "mobility_analysis/mobility_analysis.hpp"
 
@@ -161,7 +162,10 @@ int main(int argc, char** argv) {
   // The clock starts before the file is read: "full" is what `mobility_report --json` does, end to end.
   const auto start = std::chrono::steady_clock::now();
   auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  const Result<Mechanism> mechanism = loadMechanismFromFile(file);
+  // Read as mobility_report reads it (the front door of the readers).
+  ReadOptions readOptions;
+  readOptions.sideThread = !oneThread;
+  const Result<Mechanism> mechanism = readMechanism(file, readOptions);
   if (!isOk(mechanism)) return fail(diagnosticOf(mechanism).toString());
   const double loadSeconds = seconds();
   const double loadCpuSeconds = cpuSeconds();

@@ -72,6 +72,7 @@ ParsedArguments parseArguments(int argc, char** argv) {
       a.readOptions.strict = true;
     } else if (arg == "--one-thread") {
       a.oneThread = true;
+      a.readOptions.sideThread = false;
     } else if (arg == "--lock-active-cables") {
       a.lockActiveCables = true;
     } else if (arg == "--deploy" || arg == "--steps" || arg == "--deploy-to") {

@@ -427,6 +427,48 @@ TEST(XmlValues, everyNumberIsTheDoubleStrtodReads) {
   EXPECT_EQ(io_detail::parseDouble("\v 2.5\r\n"), 2.5);
 }
 
+TEST(UrdfLoader, aLargeFileChecksItsXmlOnASecondThreadWithTheSameAnswer) {
+  // From 1 MB the well-formedness walk runs beside the reader (ReadOptions::sideThread): its fault must still
+  // come first, whatever the reader finds, and a sound file must read the same. A 10^4-link chain (about 2
+  // MB) with, at its end, a repeated attribute; text outside the root; a repeated attribute and a joint to an
+  // unknown link (the reader's error, which the XML fault outranks); the unknown link alone; nothing wrong.
+  const std::string chain = straightChainUrdf(10000);
+  ASSERT_GT(chain.size(), size_t{1} << 20);
+  const std::string body = chain.substr(0, chain.rfind("</robot>"));
+  const std::string unknown =
+      R"(<joint name="bad" type="fixed"><parent link="nowhere"/><child link="l1"/></joint>)";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {body + R"(<link name="x" name="y"/></robot>)", "attribute 'name' given twice in <link>"},
+      {chain + "trailing", "text outside the root element"},
+      {body + unknown + R"(<link name="x" name="y"/></robot>)", "attribute 'name' given twice in <link>"},
+      {body + unknown + "</robot>", "nowhere"},
+      {chain, ""}};
+  for (const auto& [text, fragment] : cases) {
+    const std::string path = ::testing::TempDir() + "large_xml_check.urdf";
+    std::ofstream(path) << text;
+    ReadOptions one, two;
+    one.sideThread = false;
+    two.sideThread = true;
+    const std::pair<Result<Mechanism>, Result<Mechanism>> reads[] = {
+        {readMechanism(path, two), readMechanism(path, one)},
+        {readMechanismFromString(text, "x.urdf", two), readMechanismFromString(text, "x.urdf", one)}};
+    for (const auto& [read, reference] : reads) {
+      if (fragment.empty()) {
+        ASSERT_TRUE(isOk(read)) << diagnosticOf(read).toString();
+        ASSERT_TRUE(isOk(reference));
+        EXPECT_EQ(valueOf(read).links.size(), valueOf(reference).links.size());
+        EXPECT_EQ(valueOf(read).joints.size(), 10000u);
+      } else {
+        ASSERT_FALSE(isOk(read)) << fragment;
+        EXPECT_NE(diagnosticOf(read).toString().find(fragment), std::string::npos)
+            << diagnosticOf(read).toString();
+        ASSERT_FALSE(isOk(reference));
+        EXPECT_EQ(diagnosticOf(read).what, diagnosticOf(reference).what);
+      }
+    }
+  }
+}
+
 TEST(UrdfLoader, whatIsNotWellFormedXmlIsRefusedAndTextIsReadAsWritten) {
   const std::string tree =
       R"(<link name="a"/><link name="b"/><joint name="j" type="revolute"><parent link="a"/>)"

@@ -11,6 +11,9 @@ namespace mobility_analysis {
 struct ReadOptions {
   std::string closuresFile;  ///< A Pinocchio/Gepetto closure file (robot.yaml) for a URDF; empty: none.
   bool strict = false;       ///< Every warning is an error (the first one is returned).
+  /// A large URDF (from 1 MB) checks its well-formedness on a second thread while it is read; false: one
+  /// thread. The answer is the same.
+  bool sideThread = true;
 };
 
 /**

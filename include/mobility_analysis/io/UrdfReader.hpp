@@ -31,13 +31,13 @@ namespace mobility_analysis {
  * @param[in] fileName shown in diagnostics (its base name; may be a description such as "robot_description").
  * @return The mechanism, or the Diagnostic naming the element and the problem.
  */
-Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName);
+Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName, bool sideThread = false);
 
 /**
  * @brief readUrdf of the file at @p path, read by the XML parser into its own buffer: one copy of the text in
  *        memory instead of two (a 10^6-link chain is 0.3 GB of text).
  * @return The mechanism, or the Diagnostic ("cannot open the file" when it cannot be read).
  */
-Result<Mechanism> readUrdfFile(const std::string& path);
+Result<Mechanism> readUrdfFile(const std::string& path, bool sideThread = false);
 
 }  // namespace mobility_analysis

@@ -116,7 +116,7 @@ Result<Mechanism> readMechanismFromString(const std::string& text, const std::st
     return finish(readMjcfText(text, sourceName), options);
   if (root == "sdf")
     return finish(readSdf(text, sourceName), options);
-  return finish(readUrdf(text, sourceName), options);
+  return finish(readUrdf(text, sourceName, options.sideThread), options);
 }
 
 Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& options) {
@@ -142,7 +142,7 @@ Result<Mechanism> readMechanism(const std::string& path, const ReadOptions& opti
       return makeDiagnostic(path, "", "", "cannot open the file");
     return finish(readSdf(head, path), options);
   }
-  return finish(readUrdfFile(path), options);
+  return finish(readUrdfFile(path, options.sideThread), options);
 }
 
 }  // namespace mobility_analysis
