@@ -93,6 +93,23 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
                                        bool sideThread = false);
 
 /**
+ * @brief computeSelfStressBasis in its two steps: the sweep's basis (stresses scaled to unit largest
+ *        coefficient, rank, margins, motions), then reduceToContractOrder.
+ *
+ * Why two: what reads only the stresses (the self-stress report) can start on another thread after the
+ * first, as reduceToContractOrder writes no member but `echelon` and `contractEchelon`.
+ */
+SelfStressBasis sweepSelfStressBasis(const Mechanism& mechanism, const CoordinateModel& model,
+                                     const SparseJacobian& J, double tolerance, const ProgressCallback& progress,
+                                     size_t fillBudget, bool sideThread);
+
+/// The second step of computeSelfStressBasis: `basis.echelon` where the sweep's stresses reduce to contract
+/// order within budget, else `basis.contractEchelon` (findContractEchelon) where it is found; writes no other
+/// member.
+void reduceToContractOrder(const Mechanism& mechanism, const CoordinateModel& model, const SparseJacobian& J,
+                           double tolerance, SelfStressBasis& basis);
+
+/**
  * @brief The lecture's ordered rank test read off a self-stress basis, without eliminating in contract order.
  *
  * Equation r depends on the equations before it exactly when some self-stress has r as its last equation

@@ -114,11 +114,15 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   // One elimination in sweep order finds a local basis of the self-stresses; the ordered answer, the loops
   // and the redundant links are all read off it (SelfStressBasis.hpp, RedundantLinks.hpp).
   progress("self-stresses", 0.3);
-  const SelfStressBasis basis = computeSelfStressBasis(
+  SelfStressBasis basis = sweepSelfStressBasis(
       mechanism, model, J, tolerance,
       [&](double fraction) { progress("self-stresses", 0.3 + 0.5 * fraction); }, 0, sideTasks);
+  // The report reads the stresses and counts, which reduceToContractOrder leaves alone (it writes the
+  // basis' echelon members only): on a braced lattice the report then runs beside the contract-order
+  // reduction as well.
   core_detail::SideTask stressReportTask(
       sideTasks, [&] { return computeSelfStressInfo(mechanism, model, analysis.assembled.q, J, basis); });
+  reduceToContractOrder(mechanism, model, J, tolerance, basis);
   progress("ordered redundancy", 0.8);
   // When the basis is numerically ambiguous, the lecture's test itself in contract order decides (strict
   // partial pivoting, near-tolerance rows re-checked by their orthogonal distance: RedundancyAnalysis.hpp).

@@ -30,7 +30,9 @@ constexpr int kMaxStabilityCoordinates = 4000;
  * @param[in] model its natural-coordinate model (equations in contract order).
  * @param[in] q coordinates at the analysed pose (dim num_coordinates).
  * @param[in] J the constraint Jacobian at @p q.
- * @param[in] basis its self-stress basis (computeSelfStressBasis).
+ * @param[in] basis its self-stress basis (computeSelfStressBasis, or sweepSelfStressBasis alone: only its
+ * stresses, counts and smallest kept pivot are read, never the echelon members reduceToContractOrder writes,
+ * so the report may run while another thread completes the basis).
  * @note A locked active cable is a taut passive cable of @p mechanism (see lockActiveCables).
  */
 SelfStressInfo computeSelfStressInfo(const Mechanism& mechanism, const CoordinateModel& model,
