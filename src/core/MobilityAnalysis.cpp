@@ -187,6 +187,17 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
        ranks.smallestKeptPivot < tolerance * tolerances::kNearDecisionFactor) ||
       (ranks.largestDroppedResidual > tolerance / tolerances::kNearDecisionFactor);
 
+  // The loops and the redundant links read the structural stresses only: beside the redundant equations.
+  struct LinksAndLoops {
+    std::vector<bool> linkInLoop, jointInLoop, linkRedundant;
+  };
+  core_detail::SideTask linksTask(sideTasks, [&] {
+    LinksAndLoops found;
+    findOverConstrainedLoops(mechanism, model, finite.structuralStresses, found.linkInLoop,
+                             found.jointInLoop);
+    found.linkRedundant = findRedundantLinks(mechanism, model, finite.structuralStresses, tolerance);
+    return found;
+  });
   progress("redundant equations", 0.88);
   auto elementName = [&](const ConstraintEquation& eq) {
     return eq.source == EquationSource::Joint ? mechanism.joints[eq.element].name
@@ -226,10 +237,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   }
 
   progress("redundant links", 0.9);
-  std::vector<bool> linkInLoop, jointInLoop;
-  findOverConstrainedLoops(mechanism, model, finite.structuralStresses, linkInLoop, jointInLoop);
-  const std::vector<bool> linkRedundant =
-      findRedundantLinks(mechanism, model, finite.structuralStresses, tolerance);
+  const auto [linkInLoop, jointInLoop, linkRedundant] = linksTask.get();
   report.redundantLinksComputed = true;
   for (size_t l = 0; l < mechanism.links.size(); ++l) {
     if (linkRedundant[l])
