@@ -7,7 +7,6 @@
 #include <string_view>
 #include <vector>
 
-#include "HugePages.hpp"
 
 namespace mobility_analysis {
 namespace io_detail {
@@ -100,12 +99,7 @@ class NameIndex {
   }
 
   void rehash(size_t capacity) {
-    // Reserved, advised, then filled: probes land anywhere in the table (megabytes for 10^5 names), and on
-    // 4 KiB pages nearly each one missed the TLB as well as the cache.
-    std::vector<Slot> old;
-    old.reserve(capacity);
-    adviseHugePages(old.data(), capacity * sizeof(Slot));
-    old.resize(capacity);
+    std::vector<Slot> old(capacity);
     old.swap(slots_);
     for (const Slot& slot : old) {
       if (slot.index >= 0)

@@ -13,7 +13,6 @@
 #include <pugixml.hpp>
 
 #include "../SideTask.hpp"
-#include "HugePages.hpp"
 #include "NameIndex.hpp"
 #include "XmlValues.hpp"
 #include "mobility_analysis/Tolerances.hpp"
@@ -203,7 +202,6 @@ class Reader {
     for (int kind = kJoint; kind < kIgnored; ++kind)
       connections += byKind[kind].size();
     mechanism_.joints.reserve(connections);
-    io_detail::adviseHugePages(mechanism_.joints.data(), connections * sizeof(Joint));
     connectionIndex_.reserve(connections);
     readLinks(byKind[kLink]);
     readTreeJoints(byKind[kJoint]);

@@ -15,7 +15,6 @@
 
 #include <Eigen/Geometry>
 
-#include "HugePages.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
@@ -146,7 +145,6 @@ inline bool readWholeFile(const std::string& path, std::string& text) {
     size = static_cast<size_t>(status.st_size);
   text.clear();
   text.reserve(size + 1);
-  adviseHugePages(text.data(), text.capacity());
   size_t used = 0;
   bool ok = true;
   while (true) {
