@@ -23,43 +23,48 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   const double lc = computeCharacteristicLength(mechanism, startPoses);
   AssembledMechanism assembled;
   const ClosureLayout layout = makeClosureLayout(mechanism, startPoses, lc);
-  const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
-  int numColumns = 0;
-  const std::vector<int> columns = allColumns(layout, numColumns);
   // With no residual rows (a tree with no loop-closing connection, coupling or multi-freedom tree joint of
   // its own equations) the residual is empty, its maximum 0, and closeLoops stops before its first iteration
-  // with the start's poses: those poses are taken directly, without its three evaluations.
+  // with the start's poses: those poses are taken directly, without its three evaluations, and the start's
+  // configuration is not stored (reposeTree).
   const bool nothingToClose = layout.numResiduals == 0;
-  if (!nothingToClose) {
-    Eigen::VectorXd residual;
-    evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
-                    nullptr);
-    assembled.initialResidual = maxAbs(residual) * lc;
-  }
-
   if (driven.empty() && nothingToClose) {
-    assembled.poses = posesOf(mechanism, layout, start);
-    assembled.positions = computeJointPositions(mechanism, assembled.poses);
-  } else if (driven.empty()) {
-    Result<ClosedConfiguration> closed = closeLoops(mechanism, layout, start, columns, numColumns);
-    if (!isOk(closed))
-      return diagnosticOf(closed);
-    assembled.poses = valueOf(closed).poses;
-    assembled.iterations = valueOf(closed).iterations;
-    assembled.restarts = valueOf(closed).restarts;
+    assembled.poses = reposeTree(mechanism, layout, startPoses);
     assembled.positions = computeJointPositions(mechanism, assembled.poses);
   } else {
-    DrivenMotionSettings settings;
-    settings.lengthScale = lc;
-    Result<DrivenMotion> moved = followDrivenPositions(mechanism, startPoses, driven, settings);
-    if (!isOk(moved))
-      return diagnosticOf(moved);
-    DrivenMotion& motion = std::get<DrivenMotion>(moved);
-    assembled.poses = std::move(motion.poses);
-    assembled.iterations = motion.iterations;
-    assembled.steps = motion.steps;
-    assembled.positions = std::move(motion.positions);
-    assembled.events = std::move(motion.events);
+    const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
+    int numColumns = 0;
+    const std::vector<int> columns = allColumns(layout, numColumns);
+    if (driven.empty()) {
+      // closeLoops evaluates the start's residual first: the initial residual is its.
+      Result<ClosedConfiguration> closed = closeLoops(mechanism, layout, start, columns, numColumns);
+      if (!isOk(closed))
+        return diagnosticOf(closed);
+      ClosedConfiguration& reached = std::get<ClosedConfiguration>(closed);
+      assembled.initialResidual = reached.initialResidual * lc;
+      assembled.poses = std::move(reached.poses);
+      assembled.iterations = reached.iterations;
+      assembled.restarts = reached.restarts;
+      assembled.positions = computeJointPositions(mechanism, assembled.poses);
+    } else {
+      if (!nothingToClose) {
+        Eigen::VectorXd residual;
+        evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
+                        nullptr);
+        assembled.initialResidual = maxAbs(residual) * lc;
+      }
+      DrivenMotionSettings settings;
+      settings.lengthScale = lc;
+      Result<DrivenMotion> moved = followDrivenPositions(mechanism, startPoses, driven, settings);
+      if (!isOk(moved))
+        return diagnosticOf(moved);
+      DrivenMotion& motion = std::get<DrivenMotion>(moved);
+      assembled.poses = std::move(motion.poses);
+      assembled.iterations = motion.iterations;
+      assembled.steps = motion.steps;
+      assembled.positions = std::move(motion.positions);
+      assembled.events = std::move(motion.events);
+    }
   }
 
   Result<CoordinateModel> model = buildCoordinateModel(mechanism, assembled.poses, mode, lc);

@@ -20,8 +20,10 @@ bool solveDampedLeastSquares(const Eigen::SparseMatrix<double>& J, const Eigen::
 /// What one Levenberg–Marquardt run on the loop residual did.
 struct ClosureSolve {
   int iterations = 0;
-  double residual = 0.0;   ///< max |residual| at the end [Lc or rad].
-  bool converged = false;  ///< residual <= tolerances::kAssemblyTarget.
+  double initialResidual = 0.0;  ///< max |residual| at the start [Lc or rad].
+  double residual = 0.0;         ///< max |residual| at the end [Lc or rad].
+  bool converged = false;        ///< residual <= tolerances::kAssemblyTarget.
+  LinkPoses poses;               ///< The end point's poses (posesOf the configuration).
 };
 
 /**
@@ -42,9 +44,10 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
 struct ClosedConfiguration {
   TreeConfiguration configuration;
   LinkPoses poses;
-  double residual = 0.0;  ///< max |residual| [Lc or rad].
-  int iterations = 0;     ///< Levenberg–Marquardt iterations, restarts included.
-  int restarts = 0;       ///< Restarts needed (0: closed from the start).
+  double initialResidual = 0.0;  ///< max |residual| at the start [Lc or rad].
+  double residual = 0.0;         ///< max |residual| [Lc or rad].
+  int iterations = 0;            ///< Levenberg–Marquardt iterations, restarts included.
+  int restarts = 0;              ///< Restarts needed (0: closed from the start).
 };
 
 /**
