@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "../HugePages.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
@@ -315,7 +316,7 @@ LinkPoses posesOf(const Mechanism& mechanism, const ClosureLayout& layout,
 }
 
 LinkPoses reposeTree(const Mechanism& mechanism, const ClosureLayout& layout, const LinkPoses& poses) {
-  LinkPoses reposed(mechanism.links.size(), Eigen::Isometry3d::Identity());
+  LinkPoses reposed = core_detail::makeLinkPoses(mechanism.links.size());
   for (const int link : layout.linkOrder) {
     const int j = layout.parentJoint[link];
     if (j < 0)
