@@ -85,15 +85,21 @@ bool isSpatialOnly(JointType type) {
          type == JointType::Planar;
 }
 
-/// Per connection, its worldAxes at the pose (zero for a coupling, which has no axis): computed once for
-/// the plane's normal and the joint elements.
+/// Per connection, its worldAxes at the pose (zero for a coupling, which has no axis, and the second axis
+/// zero but for a universal joint): computed once for the plane's normal and the joint elements.
 using ConnectionAxes = std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>;
 
 ConnectionAxes computeConnectionAxes(const Mechanism& mechanism, const LinkPoses& poses) {
   ConnectionAxes axes(mechanism.joints.size(), {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
-    if (mechanism.joints[j].kind != ConnectionKind::Coupling)
-      axes[j] = worldAxes(mechanism.joints[j], poses);
+    const Joint& joint = mechanism.joints[j];
+    if (joint.kind == ConnectionKind::Coupling)
+      continue;
+    // The second axis is read for a universal joint only (classifyPlanar): the others skip its product.
+    if (joint.type == JointType::Universal)
+      axes[j] = worldAxes(joint, poses);
+    else
+      axes[j].first = worldAxis(joint, poses);
   }
   return axes;
 }

@@ -88,6 +88,8 @@ struct ModelBuilder {
 
 /// Joint axis (and universal second axis) of a connection in the world frame at @p poses.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> worldAxes(const Joint& joint, const LinkPoses& poses);
+/// worldAxes(...).first alone.
+Eigen::Vector3d worldAxis(const Joint& joint, const LinkPoses& poses);
 
 /// Phase 1: elements at the joints; fails on a joint that cannot act in the plane or a cable longer than its
 /// length.
