@@ -7,7 +7,6 @@
 #include <utility>
 #include <vector>
 
-#include "HugePages.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
@@ -90,7 +89,7 @@ JointPositions toJointPositions(const std::vector<std::pair<std::string_view, do
 
 LinkPoses computeTreePoses(const Mechanism& mechanism, const JointPositions& positions) {
   const size_t numLinks = mechanism.links.size();
-  LinkPoses poses = core_detail::makeLinkPoses(numLinks);
+  LinkPoses poses(numLinks, Eigen::Isometry3d::Identity());
   std::vector<int> parentJoint(numLinks, -1);
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     if (mechanism.joints[j].kind == ConnectionKind::TreeJoint) {

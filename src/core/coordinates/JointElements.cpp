@@ -1,7 +1,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "../HugePages.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/coordinates/ModelBuilder.hpp"
 
@@ -42,8 +41,6 @@ std::optional<Diagnostic> addJointElements(ModelBuilder& builder) {
   const size_t elements = 4 * mechanism.joints.size() + 3 * mechanism.links.size();
   model.elements.reserve(elements);
   builder.world.reserve(elements);
-  core_detail::adviseHugePagesOf(model.elements);
-  core_detail::adviseHugePagesOf(builder.world);
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     const Joint& joint = mechanism.joints[j];
     ConnectionElements& c = builder.connections[j];

@@ -3,7 +3,6 @@
 
 #include <Eigen/Dense>
 
-#include "../HugePages.hpp"
 #include "mobility_analysis/coordinates/ModelBuilder.hpp"
 
 namespace mobility_analysis {
@@ -24,7 +23,6 @@ void addRigidLinkEquations(ModelBuilder& builder) {
       count += static_cast<size_t>(std::max(model.lambda - model.jointFreedom[j], 0));
   }
   model.equations.reserve(model.equations.size() + count + static_cast<size_t>(2 * model.lambda));
-  core_detail::adviseHugePagesOf(model.equations);
   for (size_t b = 0; b < builder.mechanism.links.size(); ++b) {
     const BodyBasis& basis = builder.bases[b];
     const std::array<Direction, 2> dirs = {basis.d1, basis.d2};

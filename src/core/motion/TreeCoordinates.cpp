@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "../HugePages.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
@@ -316,7 +315,7 @@ LinkPoses posesOf(const Mechanism& mechanism, const ClosureLayout& layout,
 }
 
 LinkPoses reposeTree(const Mechanism& mechanism, const ClosureLayout& layout, const LinkPoses& poses) {
-  LinkPoses reposed = core_detail::makeLinkPoses(mechanism.links.size());
+  LinkPoses reposed(mechanism.links.size(), Eigen::Isometry3d::Identity());
   for (const int link : layout.linkOrder) {
     const int j = layout.parentJoint[link];
     if (j < 0)
