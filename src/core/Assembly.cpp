@@ -23,48 +23,56 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   const double lc = computeCharacteristicLength(mechanism, startPoses);
   AssembledMechanism assembled;
   const ClosureLayout layout = makeClosureLayout(mechanism, startPoses, lc);
-  // With no residual rows (a tree with no loop-closing connection, coupling or multi-freedom tree joint of
-  // its own equations) the residual is empty, its maximum 0, and closeLoops stops before its first iteration
-  // with the start's poses: those poses are taken directly, without its three evaluations, and the start's
-  // configuration is not stored (reposeTree).
   const bool nothingToClose = layout.numResiduals == 0;
-  if (driven.empty() && nothingToClose) {
-    assembled.poses = reposeTree(mechanism, layout, startPoses);
+  if (driven.empty()) {
+    // closeLoops begins with the start's poses (reposeTree is posesOf(configurationFromPoses)) and their
+    // residual, and stops there when the loops close already: with no residual rows (a tree with no
+    // loop-closing connection, coupling or multi-freedom tree joint of its own equations) or at a written
+    // pose that closes (a lattice of bars). Those poses are taken directly then, and no configuration is
+    // made.
+    LinkPoses poses = reposeTree(mechanism, layout, startPoses);
+    bool closed = true;
+    if (!nothingToClose) {
+      int numColumns = 0;
+      const std::vector<int> columns = allColumns(layout, numColumns);
+      Eigen::VectorXd residual;
+      evaluateClosure(mechanism, layout, poses, columns, numColumns, residual, nullptr);
+      assembled.initialResidual = maxAbs(residual) * lc;
+      closed = maxAbs(residual) <= tolerances::kAssemblyTarget;
+      if (!closed) {
+        Result<ClosedConfiguration> reached = closeLoops(
+            mechanism, layout, configurationFromPoses(mechanism, layout, startPoses), columns, numColumns);
+        if (!isOk(reached))
+          return diagnosticOf(reached);
+        ClosedConfiguration& loops = std::get<ClosedConfiguration>(reached);
+        poses = std::move(loops.poses);
+        assembled.iterations = loops.iterations;
+        assembled.restarts = loops.restarts;
+      }
+    }
+    assembled.poses = std::move(poses);
     assembled.positions = computeJointPositions(mechanism, assembled.poses);
   } else {
     const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
     int numColumns = 0;
     const std::vector<int> columns = allColumns(layout, numColumns);
-    if (driven.empty()) {
-      // closeLoops evaluates the start's residual first: the initial residual is its.
-      Result<ClosedConfiguration> closed = closeLoops(mechanism, layout, start, columns, numColumns);
-      if (!isOk(closed))
-        return diagnosticOf(closed);
-      ClosedConfiguration& reached = std::get<ClosedConfiguration>(closed);
-      assembled.initialResidual = reached.initialResidual * lc;
-      assembled.poses = std::move(reached.poses);
-      assembled.iterations = reached.iterations;
-      assembled.restarts = reached.restarts;
-      assembled.positions = computeJointPositions(mechanism, assembled.poses);
-    } else {
-      if (!nothingToClose) {
-        Eigen::VectorXd residual;
-        evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
-                        nullptr);
-        assembled.initialResidual = maxAbs(residual) * lc;
-      }
-      DrivenMotionSettings settings;
-      settings.lengthScale = lc;
-      Result<DrivenMotion> moved = followDrivenPositions(mechanism, startPoses, driven, settings);
-      if (!isOk(moved))
-        return diagnosticOf(moved);
-      DrivenMotion& motion = std::get<DrivenMotion>(moved);
-      assembled.poses = std::move(motion.poses);
-      assembled.iterations = motion.iterations;
-      assembled.steps = motion.steps;
-      assembled.positions = std::move(motion.positions);
-      assembled.events = std::move(motion.events);
+    if (!nothingToClose) {
+      Eigen::VectorXd residual;
+      evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
+                      nullptr);
+      assembled.initialResidual = maxAbs(residual) * lc;
     }
+    DrivenMotionSettings settings;
+    settings.lengthScale = lc;
+    Result<DrivenMotion> moved = followDrivenPositions(mechanism, startPoses, driven, settings);
+    if (!isOk(moved))
+      return diagnosticOf(moved);
+    DrivenMotion& motion = std::get<DrivenMotion>(moved);
+    assembled.poses = std::move(motion.poses);
+    assembled.iterations = motion.iterations;
+    assembled.steps = motion.steps;
+    assembled.positions = std::move(motion.positions);
+    assembled.events = std::move(motion.events);
   }
 
   Result<CoordinateModel> model = buildCoordinateModel(mechanism, assembled.poses, mode, lc);

@@ -20,10 +20,9 @@ bool solveDampedLeastSquares(const Eigen::SparseMatrix<double>& J, const Eigen::
 /// What one Levenberg–Marquardt run on the loop residual did.
 struct ClosureSolve {
   int iterations = 0;
-  double initialResidual = 0.0;  ///< max |residual| at the start [Lc or rad].
-  double residual = 0.0;         ///< max |residual| at the end [Lc or rad].
-  bool converged = false;        ///< residual <= tolerances::kAssemblyTarget.
-  LinkPoses poses;               ///< The end point's poses (posesOf the configuration).
+  double residual = 0.0;   ///< max |residual| at the end [Lc or rad].
+  bool converged = false;  ///< residual <= tolerances::kAssemblyTarget.
+  LinkPoses poses;         ///< The end point's poses (posesOf the configuration).
 };
 
 /**
@@ -44,10 +43,9 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
 struct ClosedConfiguration {
   TreeConfiguration configuration;
   LinkPoses poses;
-  double initialResidual = 0.0;  ///< max |residual| at the start [Lc or rad].
-  double residual = 0.0;         ///< max |residual| [Lc or rad].
-  int iterations = 0;            ///< Levenberg–Marquardt iterations, restarts included.
-  int restarts = 0;              ///< Restarts needed (0: closed from the start).
+  double residual = 0.0;  ///< max |residual| [Lc or rad].
+  int iterations = 0;     ///< Levenberg–Marquardt iterations, restarts included.
+  int restarts = 0;       ///< Restarts needed (0: closed from the start).
 };
 
 /**

@@ -61,7 +61,6 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
   // Closed already (the usual case for a written or previous pose): no Jacobian, whose rows walk the tree
   // paths of every loop (long on deep trees such as a mast written as one chain).
   evaluateClosure(mechanism, layout, poses, columns, numColumns, r, nullptr);
-  result.initialResidual = maxAbs(r);
   if (maxAbs(r) <= tolerances::kAssemblyTarget) {
     result.residual = maxAbs(r);
     result.converged = true;
@@ -137,7 +136,6 @@ Result<ClosedConfiguration> closeLoops(const Mechanism& mechanism, const Closure
   ClosureSolve first = solveClosure(mechanism, layout, columns, numColumns, best.configuration,
                                     tolerances::kClosureMaxIterations);
   iterations += first.iterations;
-  best.initialResidual = first.initialResidual;
   if (first.converged) {
     // The first run's end point is the answer: its poses and residual, not computed a second time.
     best.poses = std::move(first.poses);
