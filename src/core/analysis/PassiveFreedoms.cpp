@@ -133,6 +133,7 @@ struct SearchContext {
   core_detail::BucketRange connectionsAt(int l) const { return connections_[l]; }
   std::vector<std::pair<int, int>> jointEnds;  ///< Per connection, link1 and link2 (read once: a Joint is
                                                ///< hundreds of bytes).
+  std::vector<char> weld;                      ///< Per connection, whether it is a fixed joint (no body).
   std::vector<double> rowNorm;                 ///< Per row of J, its norm.
   std::vector<int> jointOfRow;                 ///< Per row of J, its connection (-1: a link's, the ground's).
 
@@ -151,6 +152,7 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
       planar(model.dim == 2),
       lambda(model.lambda),
       jointEnds(mechanism.joints.size()),
+      weld(mechanism.joints.size(), 0),
       rowNorm(static_cast<size_t>(J.rows())),
       connections_(numLinks) {
   // Connections that constrain, and the links they join (a connection joining a link to itself is listed
@@ -167,6 +169,7 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
   }
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     jointEnds[j] = {mechanism.joints[j].link1, mechanism.joints[j].link2};
+    weld[j] = mechanism.joints[j].type == JointType::Fixed ? 1 : 0;
     if (equationsOf[j] == 0)
       continue;
     connections_.count(jointEnds[j].first);
@@ -233,9 +236,10 @@ class EndConnectionBound {
   bool rigidByEndsOf(const std::vector<int>& path) const;
   static constexpr size_t kLinksPerRow = 4;
   /// Per coordinate, the element and the link that own it.
-  struct ColumnOwners {
-    std::vector<int> element, link;
+  struct ColumnOwner {
+    int element = -1, link = -1;
   };
+  using ColumnOwners = std::vector<ColumnOwner>;  // side by side: one cache line a column
   /// One row of J, scaled to unit norm, times T, split into its parts a_{r,l} on each link it touches.
   struct RowParts {
     std::array<std::pair<int, TwistRow>, kLinksPerRow> perLink;
@@ -277,14 +281,11 @@ EndConnectionBound::EndConnectionBound(const SearchContext& context)
 
 EndConnectionBound::ColumnOwners EndConnectionBound::findColumnOwners() const {
   const CoordinateModel& model = context_.model;
-  const size_t numCoordinates = static_cast<size_t>(model.numCoordinates());
-  ColumnOwners owners{std::vector<int>(numCoordinates, -1), std::vector<int>(numCoordinates, -1)};
+  ColumnOwners owners(static_cast<size_t>(model.numCoordinates()));
   for (size_t l = 0; l < model.bodyElements.size(); ++l) {
     for (int e : model.bodyElements[l]) {
-      for (int k = 0; k < context_.dim; ++k) {
-        owners.element[static_cast<size_t>(model.elements[e].offset + k)] = e;
-        owners.link[static_cast<size_t>(model.elements[e].offset + k)] = static_cast<int>(l);
-      }
+      for (int k = 0; k < context_.dim; ++k)
+        owners[static_cast<size_t>(model.elements[e].offset + k)] = ColumnOwner{e, static_cast<int>(l)};
     }
   }
   return owners;
@@ -295,7 +296,8 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
   parts.overflow = false;
   const double norm = context_.rowNorm[static_cast<size_t>(r)];
   for (SparseJacobian::InnerIterator it(context_.J, r); it; ++it) {
-    const int l = owners.link[static_cast<size_t>(it.col())];
+    const ColumnOwner& owner = owners[static_cast<size_t>(it.col())];
+    const int l = owner.link;
     size_t slot = 0;
     while (slot < parts.used && parts.perLink[slot].first != l)
       ++slot;
@@ -307,7 +309,7 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
       }
       parts.perLink[parts.used++] = {l, TwistRow::Zero()};
     }
-    const int e = owners.element[static_cast<size_t>(it.col())];
+    const int e = owner.element;
     const int k = static_cast<int>(it.col()) - context_.model.elements[e].offset;
     parts.perLink[slot].second += (it.value() / norm) * context_.twistRow(e, k);
   }
@@ -441,8 +443,7 @@ void extendChain(const SearchContext& context, std::vector<int>& path, size_t bo
     return;
   for (int j : context.connectionsAt(last)) {
     const int next = context.otherLink(j, last);
-    const size_t more =
-        bodies + (context.mechanism.joints[static_cast<size_t>(j)].type == JointType::Fixed ? 0 : 1);
+    const size_t more = bodies + (context.weld[static_cast<size_t>(j)] ? 0 : 1);
     if (more > kMaxGroup || next == context.mechanism.rootLink || context.connectionsAt(next).size() != 2 ||
         std::find(path.begin(), path.end(), next) != path.end())
       continue;
