@@ -228,10 +228,12 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
   layout.unknownOffset.assign(numJoints, -1);
   layout.unknownCount.assign(numJoints, 0);
   layout.length.assign(numJoints, 0.0);
+  std::vector<int> parentLink(numLinks, -1);  // the walk below reads no Joint (hundreds of bytes each)
   for (int j = 0; j < numJoints; ++j) {
     const Joint& joint = mechanism.joints[j];
     if (joint.kind == ConnectionKind::TreeJoint) {
       layout.parentJoint[joint.link2] = j;
+      parentLink[joint.link2] = joint.link1;
       const int count = isOneFreedomTree(joint) ? 1 : joint.type == JointType::Fixed ? 0 : 6;
       if (count > 0) {
         layout.unknownOffset[j] = layout.numUnknowns;
@@ -244,11 +246,11 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
   std::vector<bool> placed(numLinks, false);
   std::vector<int> chain;
   placed[mechanism.rootLink] = true;
+  layout.linkOrder.reserve(numLinks);
   layout.linkOrder.push_back(mechanism.rootLink);
   for (int link = 0; link < numLinks; ++link) {
     chain.clear();
-    for (int l = link; !placed[l] && layout.parentJoint[l] >= 0;
-         l = mechanism.joints[layout.parentJoint[l]].link1)
+    for (int l = link; !placed[l] && layout.parentJoint[l] >= 0; l = parentLink[l])
       chain.push_back(l);
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
       placed[*it] = true;
