@@ -79,7 +79,9 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   if (!isOk(model))
     return diagnosticOf(model);
   assembled.model = valueOf(std::move(model));
-  assembled.q = computeCoordinates(assembled.model, assembled.poses);
+  // q0 is computeCoordinates at the poses the model was built at, value for value (the same products): a
+  // copy, not a second pass over every element and its body's pose.
+  assembled.q = assembled.model.q0;
   Eigen::VectorXd phi;
   computeConstraintResidual(assembled.model, assembled.q, phi);
   assembled.finalResidual = maxAbs(phi) * lc;
