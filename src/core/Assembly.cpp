@@ -23,32 +23,45 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   const double lc = computeCharacteristicLength(mechanism, startPoses);
   AssembledMechanism assembled;
   const ClosureLayout layout = makeClosureLayout(mechanism, startPoses, lc);
-  const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
-  int numColumns = 0;
-  const std::vector<int> columns = allColumns(layout, numColumns);
-  // With no residual rows (a tree with no loop-closing connection, coupling or multi-freedom tree joint of
-  // its own equations) the residual is empty, its maximum 0, and closeLoops stops before its first iteration
-  // with the start's poses: those poses are taken directly, without its three evaluations.
   const bool nothingToClose = layout.numResiduals == 0;
-  if (!nothingToClose) {
-    Eigen::VectorXd residual;
-    evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
-                    nullptr);
-    assembled.initialResidual = maxAbs(residual) * lc;
-  }
-
-  if (driven.empty() && nothingToClose) {
-    assembled.poses = posesOf(mechanism, layout, start);
-    assembled.positions = computeJointPositions(mechanism, assembled.poses);
-  } else if (driven.empty()) {
-    Result<ClosedConfiguration> closed = closeLoops(mechanism, layout, start, columns, numColumns);
-    if (!isOk(closed))
-      return diagnosticOf(closed);
-    assembled.poses = valueOf(closed).poses;
-    assembled.iterations = valueOf(closed).iterations;
-    assembled.restarts = valueOf(closed).restarts;
+  if (driven.empty()) {
+    // closeLoops begins with the start's poses (reposeTree is posesOf(configurationFromPoses)) and their
+    // residual, and stops there when the loops close already: with no residual rows (a tree with no
+    // loop-closing connection, coupling or multi-freedom tree joint of its own equations) or at a written
+    // pose that closes (a lattice of bars). Those poses are taken directly then, and no configuration is
+    // made.
+    LinkPoses poses = reposeTree(mechanism, layout, startPoses);
+    bool closed = true;
+    if (!nothingToClose) {
+      int numColumns = 0;
+      const std::vector<int> columns = allColumns(layout, numColumns);
+      Eigen::VectorXd residual;
+      evaluateClosure(mechanism, layout, poses, columns, numColumns, residual, nullptr);
+      assembled.initialResidual = maxAbs(residual) * lc;
+      closed = maxAbs(residual) <= tolerances::kAssemblyTarget;
+      if (!closed) {
+        Result<ClosedConfiguration> reached = closeLoops(
+            mechanism, layout, configurationFromPoses(mechanism, layout, startPoses), columns, numColumns);
+        if (!isOk(reached))
+          return diagnosticOf(reached);
+        ClosedConfiguration& loops = std::get<ClosedConfiguration>(reached);
+        poses = std::move(loops.poses);
+        assembled.iterations = loops.iterations;
+        assembled.restarts = loops.restarts;
+      }
+    }
+    assembled.poses = std::move(poses);
     assembled.positions = computeJointPositions(mechanism, assembled.poses);
   } else {
+    const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
+    int numColumns = 0;
+    const std::vector<int> columns = allColumns(layout, numColumns);
+    if (!nothingToClose) {
+      Eigen::VectorXd residual;
+      evaluateClosure(mechanism, layout, posesOf(mechanism, layout, start), columns, numColumns, residual,
+                      nullptr);
+      assembled.initialResidual = maxAbs(residual) * lc;
+    }
     DrivenMotionSettings settings;
     settings.lengthScale = lc;
     Result<DrivenMotion> moved = followDrivenPositions(mechanism, startPoses, driven, settings);
@@ -66,7 +79,9 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
   if (!isOk(model))
     return diagnosticOf(model);
   assembled.model = valueOf(std::move(model));
-  assembled.q = computeCoordinates(assembled.model, assembled.poses);
+  // q0 is computeCoordinates at the poses the model was built at, value for value (the same products): a
+  // copy, not a second pass over every element and its body's pose.
+  assembled.q = assembled.model.q0;
   Eigen::VectorXd phi;
   computeConstraintResidual(assembled.model, assembled.q, phi);
   assembled.finalResidual = maxAbs(phi) * lc;

@@ -85,14 +85,34 @@ bool isSpatialOnly(JointType type) {
          type == JointType::Planar;
 }
 
+/// Per connection, its worldAxes at the pose (zero for a coupling, which has no axis, and the second axis
+/// zero but for a universal joint): computed once for the plane's normal and the joint elements.
+using ConnectionAxes = std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>;
+
+ConnectionAxes computeConnectionAxes(const Mechanism& mechanism, const LinkPoses& poses) {
+  ConnectionAxes axes(mechanism.joints.size(), {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    const Joint& joint = mechanism.joints[j];
+    if (joint.kind == ConnectionKind::Coupling)
+      continue;
+    // The second axis is read for a universal joint only (classifyPlanar): the others skip its product.
+    if (joint.type == JointType::Universal)
+      axes[j] = worldAxes(joint, poses);
+    else
+      axes[j].first = worldAxis(joint, poses);
+  }
+  return axes;
+}
+
 /// A normal candidate: the first revolute axis, else the normal of two slide axes, else the root's z.
-Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const LinkPoses& poses) {
+Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const ConnectionAxes& axes) {
   std::vector<Eigen::Vector3d> slides;
-  for (const Joint& joint : mechanism.joints) {
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    const Joint& joint = mechanism.joints[j];
     if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
         joint.kind == ConnectionKind::Coupling)
       continue;
-    const Eigen::Vector3d axis = worldAxes(joint, poses).first;
+    const Eigen::Vector3d axis = axes[j].first;
     if (joint.type == JointType::Revolute || joint.type == JointType::Continuous)
       return axis;
     if (joint.type == JointType::Prismatic)
@@ -112,22 +132,22 @@ Eigen::Vector3d candidateNormal(const Mechanism& mechanism, const LinkPoses& pos
   return n;
 }
 
-}  // namespace
-
-std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const LinkPoses& poses) {
+/// findPlaneNormal with the connections' axes at @p poses given.
+std::optional<Eigen::Vector3d> findPlaneNormalOf(const Mechanism& mechanism, const LinkPoses& poses,
+                                                 const ConnectionAxes& axes) {
   for (const Joint& joint : mechanism.joints) {
     if (joint.kind != ConnectionKind::DistanceConstraint && joint.kind != ConnectionKind::Cable &&
         joint.kind != ConnectionKind::Coupling && isSpatialOnly(joint.type)) {
       return std::nullopt;
     }
   }
-  const Eigen::Vector3d normal = candidateNormal(mechanism, poses);
-  for (const Joint& joint : mechanism.joints) {
+  const Eigen::Vector3d normal = candidateNormal(mechanism, axes);
+  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
+    const Joint& joint = mechanism.joints[j];
     if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||
         joint.kind == ConnectionKind::Coupling)
       continue;
-    const auto axes = worldAxes(joint, poses);
-    if (classifyPlanar(joint, axes.first, axes.second, normal) == PlanarForm::Invalid) {
+    if (classifyPlanar(joint, axes[j].first, axes[j].second, normal) == PlanarForm::Invalid) {
       return std::nullopt;
     }
   }
@@ -143,6 +163,12 @@ std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const
       return std::nullopt;
   }
   return normal;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> findPlaneNormal(const Mechanism& mechanism, const LinkPoses& poses) {
+  return findPlaneNormalOf(mechanism, poses, computeConnectionAxes(mechanism, poses));
 }
 
 namespace {
@@ -167,13 +193,14 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
                                              AnalysisMode mode, double characteristicLength) {
   CoordinateModel model;
   model.characteristicLength = characteristicLength;
-  const std::optional<Eigen::Vector3d> planeNormal = findPlaneNormal(mechanism, poses);
+  ConnectionAxes axes = computeConnectionAxes(mechanism, poses);
+  const std::optional<Eigen::Vector3d> planeNormal = findPlaneNormalOf(mechanism, poses, axes);
   const bool planar = mode == AnalysisMode::Planar || (mode == AnalysisMode::Auto && planeNormal.has_value());
   model.mode = planar ? AnalysisMode::Planar : AnalysisMode::Spatial;
   model.dim = planar ? 2 : 3;
   model.lambda = planar ? 3 : 6;
   if (planar) {
-    model.planeNormal = planeNormal ? *planeNormal : candidateNormal(mechanism, poses);
+    model.planeNormal = planeNormal ? *planeNormal : candidateNormal(mechanism, axes);
     // e1 along the root's x projected into the plane, so the planar coordinates read like the URDF's.
     Eigen::Vector3d e1 =
         Eigen::Vector3d::UnitX() - model.planeNormal.dot(Eigen::Vector3d::UnitX()) * model.planeNormal;
@@ -196,6 +223,7 @@ Result<CoordinateModel> buildCoordinateModel(const Mechanism& mechanism, const L
 
   // The phases of ModelBuilder.hpp, in order; each lives in its own file under src/core/coordinates/.
   ModelBuilder builder(mechanism, poses, model);
+  builder.axes = std::move(axes);
   if (std::optional<Diagnostic> error = addJointElements(builder))
     return *error;
   addBodyBases(builder);

@@ -1,5 +1,9 @@
 #include "mobility_analysis/Assembly.hpp"
 
+#include <functional>
+#include <string>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "core/TestModels.hpp"
@@ -121,4 +125,39 @@ TEST(Assembly, UnclosableMessageIsOneLineWithTheResidualAndThePoseReached) {
   EXPECT_EQ(line.find('\n'), std::string::npos) << line;
   EXPECT_NE(line.find("residual"), std::string::npos) << line;
   EXPECT_NE(line.find("pose reached: j1="), std::string::npos) << line;
+}
+
+TEST(Assembly, JointPositionsAreReadBackByNameWhateverTheirLength) {
+  // Names sorted by a key of eight bytes after their common prefix: short tails (j1 .. j12, out of their
+  // lexicographic order), tails of eight bytes and more, and long tails that share their first eight bytes.
+  const std::vector<std::function<std::string(int)>> namings = {
+      [](int i) { return "j" + std::to_string(i); },
+      [](int i) { return "joint_" + std::to_string(i); },
+      [](int i) { return "abcdefghijklmnop_" + std::to_string(i); },
+      [](int i) { return (i % 2 == 1 ? std::string("p") : "q" + std::string(10, 'z')) + std::to_string(i); },
+      [](int i) { return std::string(static_cast<size_t>(i), 'k'); },
+  };
+  for (size_t n = 0; n < namings.size(); ++n) {
+    SCOPED_TRACE(n);
+    std::string text = straightChainUrdf(12);
+    for (int i = 12; i >= 1; --i) {
+      const std::string from = "name='j" + std::to_string(i) + "'";
+      const size_t at = text.find(from);
+      ASSERT_NE(at, std::string::npos);
+      text.replace(at, from.size(), "name='" + namings[n](i) + "'");
+    }
+    Result<Mechanism> loaded = loadMechanismFromString(text, "names.urdf");
+    ASSERT_TRUE(isOk(loaded)) << diagnosticOf(loaded).toString();
+    const Mechanism& mechanism = valueOf(loaded);
+    JointPositions written;
+    for (int i = 1; i <= 12; ++i)
+      written[namings[n](i)] = 0.01 * i;
+    const JointPositions back = computeJointPositions(mechanism, computeTreePoses(mechanism, written));
+    ASSERT_EQ(back.size(), written.size());
+    auto b = back.begin();
+    for (auto w = written.cbegin(); w != written.cend(); ++w, ++b) {
+      EXPECT_EQ(b->first, w->first);  // the same names, in the map's order
+      EXPECT_NEAR(b->second, w->second, 1e-12);
+    }
+  }
 }

@@ -1,6 +1,8 @@
 #include "mobility_analysis/NaturalCoordinates.hpp"
 
+#include <cstring>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -110,4 +112,24 @@ TEST(NaturalCoordinates, EveryNonRedundantReferenceKeepsItsDofAtAPoseOffByTheAss
               {"sle_mast.urdf", AnalysisMode::Planar, 1}};
   for (const auto& row : rows)
     expectDofSurvivesPerturbation(loadOrFail(urdfPath(row.file)), row.mode, row.dof);
+}
+
+TEST(NaturalCoordinates, ModelCoordinatesAreThoseOfItsPoseBitForBit) {
+  // assembleMechanism takes q from q0 instead of computing it again: they must agree to the last bit, in the
+  // plane and in space, for points and unit vectors, auxiliary elements included.
+  for (const char* name : {"four_bar.urdf", "bennett.urdf", "sarrus.urdf", "puma560.urdf", "delta_robot.urdf",
+                           "peaucellier.urdf", "stewart_6sps.urdf", "sle_mast.urdf"}) {
+    for (const AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial}) {
+      SCOPED_TRACE(name);
+      const Mechanism mechanism = loadOrFail(urdfPath(name));
+      const LinkPoses poses = computeTreePoses(mechanism, {});
+      const Result<CoordinateModel> model =
+          buildCoordinateModel(mechanism, poses, mode, computeCharacteristicLength(mechanism, poses));
+      ASSERT_TRUE(isOk(model)) << diagnosticOf(model).toString();
+      const Eigen::VectorXd q = computeCoordinates(valueOf(model), poses);
+      ASSERT_EQ(q.size(), valueOf(model).q0.size());
+      for (Eigen::Index i = 0; i < q.size(); ++i)
+        EXPECT_EQ(std::memcmp(&q(i), &valueOf(model).q0(i), sizeof(double)), 0) << i;
+    }
+  }
 }

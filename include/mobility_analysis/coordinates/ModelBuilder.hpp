@@ -63,7 +63,9 @@ struct ModelBuilder {
   const Mechanism& mechanism;
   const LinkPoses& poses;
   CoordinateModel& model;
-  std::vector<Eigen::Vector3d> world;           ///< Element values at the pose (normalised, full 3-D).
+  std::vector<Eigen::Vector3d> world;  ///< Element values at the pose (normalised, full 3-D).
+  /// Per connection, worldAxes at the pose (zero for a coupling).
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> axes;
   std::vector<ConnectionElements> connections;  ///< Per joint (phase 1).
   std::vector<BodyBasis> bases;                 ///< Per link (phase 2).
 
@@ -86,6 +88,8 @@ struct ModelBuilder {
 
 /// Joint axis (and universal second axis) of a connection in the world frame at @p poses.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> worldAxes(const Joint& joint, const LinkPoses& poses);
+/// worldAxes(...).first alone.
+Eigen::Vector3d worldAxis(const Joint& joint, const LinkPoses& poses);
 
 /// Phase 1: elements at the joints; fails on a joint that cannot act in the plane or a cable longer than its
 /// length.

@@ -22,6 +22,7 @@ struct ClosureSolve {
   int iterations = 0;
   double residual = 0.0;   ///< max |residual| at the end [Lc or rad].
   bool converged = false;  ///< residual <= tolerances::kAssemblyTarget.
+  LinkPoses poses;         ///< The end point's poses (posesOf the configuration).
 };
 
 /**

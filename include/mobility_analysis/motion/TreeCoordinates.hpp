@@ -64,6 +64,10 @@ TreeConfiguration configurationFromPoses(const Mechanism& mechanism, const Closu
 LinkPoses posesOf(const Mechanism& mechanism, const ClosureLayout& layout,
                   const TreeConfiguration& configuration);
 
+/// @return posesOf(configurationFromPoses(@p poses)), in one pass: no configuration is stored (10^5 joints'
+///         motions were 13 MB of fresh pages when the tree has nothing to close).
+LinkPoses reposeTree(const Mechanism& mechanism, const ClosureLayout& layout, const LinkPoses& poses);
+
 /**
  * @brief The loop residual at @p poses and, if @p jacobian is not null, its derivative with respect to the
  *        unknowns kept by @p columns.

@@ -84,7 +84,7 @@ bool choleskyLower(Eigen::Matrix<double, L, L>& m) {
 }
 
 /// @return Whether sigma_min(A) > @p bound is certain from G = A^T A (L x L): sigma_min(A)^2 is at least
-/// 1 / |G^-1|_F.
+/// 1 / |G^-1|_F. Only the lower triangle of @p gram is read.
 template <int L>
 bool clearlyFullRank(const Eigen::Matrix<double, L, L>& gram, double bound) {
   Eigen::Matrix<double, L, L> factor = gram;
@@ -133,6 +133,7 @@ struct SearchContext {
   core_detail::BucketRange connectionsAt(int l) const { return connections_[l]; }
   std::vector<std::pair<int, int>> jointEnds;  ///< Per connection, link1 and link2 (read once: a Joint is
                                                ///< hundreds of bytes).
+  std::vector<char> weld;                      ///< Per connection, whether it is a fixed joint (no body).
   std::vector<double> rowNorm;                 ///< Per row of J, its norm.
   std::vector<int> jointOfRow;                 ///< Per row of J, its connection (-1: a link's, the ground's).
 
@@ -151,6 +152,7 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
       planar(model.dim == 2),
       lambda(model.lambda),
       jointEnds(mechanism.joints.size()),
+      weld(mechanism.joints.size(), 0),
       rowNorm(static_cast<size_t>(J.rows())),
       connections_(numLinks) {
   // Connections that constrain, and the links they join (a connection joining a link to itself is listed
@@ -167,6 +169,7 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
   }
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     jointEnds[j] = {mechanism.joints[j].link1, mechanism.joints[j].link2};
+    weld[j] = mechanism.joints[j].type == JointType::Fixed ? 1 : 0;
     if (equationsOf[j] == 0)
       continue;
     connections_.count(jointEnds[j].first);
@@ -233,9 +236,10 @@ class EndConnectionBound {
   bool rigidByEndsOf(const std::vector<int>& path) const;
   static constexpr size_t kLinksPerRow = 4;
   /// Per coordinate, the element and the link that own it.
-  struct ColumnOwners {
-    std::vector<int> element, link;
+  struct ColumnOwner {
+    int element = -1, link = -1;
   };
+  using ColumnOwners = std::vector<ColumnOwner>;  // side by side: one cache line a column
   /// One row of J, scaled to unit norm, times T, split into its parts a_{r,l} on each link it touches.
   struct RowParts {
     std::array<std::pair<int, TwistRow>, kLinksPerRow> perLink;
@@ -255,12 +259,14 @@ class EndConnectionBound {
   const SearchContext& context_;
   const size_t gramSize_;
   std::vector<double> linkFrobenius_;
-  std::vector<double> endGram_;  // per link, per connection slot 0 or 1: lambda x lambda
-  std::vector<char> endValid_;   // per link and slot
+  // Per link, per connection slot 0 or 1: the lower triangle of the lambda x lambda Gram matrix, row by row
+  // (clearlyFullRank reads no other entry; 6 of 9 numbers in the plane, 21 of 36 in space).
+  std::vector<double> endGram_;
+  std::vector<char> endValid_;  // per link and slot
 };
 
 EndConnectionBound::EndConnectionBound(const SearchContext& context)
-    : context_(context), gramSize_(static_cast<size_t>(context.lambda * context.lambda)) {
+    : context_(context), gramSize_(static_cast<size_t>(context.lambda * (context.lambda + 1) / 2)) {
   const ColumnOwners owners = findColumnOwners();
   const size_t numLinks = static_cast<size_t>(context_.numLinks);
   linkFrobenius_.assign(numLinks, 0.0);
@@ -275,14 +281,11 @@ EndConnectionBound::EndConnectionBound(const SearchContext& context)
 
 EndConnectionBound::ColumnOwners EndConnectionBound::findColumnOwners() const {
   const CoordinateModel& model = context_.model;
-  const size_t numCoordinates = static_cast<size_t>(model.numCoordinates());
-  ColumnOwners owners{std::vector<int>(numCoordinates, -1), std::vector<int>(numCoordinates, -1)};
+  ColumnOwners owners(static_cast<size_t>(model.numCoordinates()));
   for (size_t l = 0; l < model.bodyElements.size(); ++l) {
     for (int e : model.bodyElements[l]) {
-      for (int k = 0; k < context_.dim; ++k) {
-        owners.element[static_cast<size_t>(model.elements[e].offset + k)] = e;
-        owners.link[static_cast<size_t>(model.elements[e].offset + k)] = static_cast<int>(l);
-      }
+      for (int k = 0; k < context_.dim; ++k)
+        owners[static_cast<size_t>(model.elements[e].offset + k)] = ColumnOwner{e, static_cast<int>(l)};
     }
   }
   return owners;
@@ -293,7 +296,8 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
   parts.overflow = false;
   const double norm = context_.rowNorm[static_cast<size_t>(r)];
   for (SparseJacobian::InnerIterator it(context_.J, r); it; ++it) {
-    const int l = owners.link[static_cast<size_t>(it.col())];
+    const ColumnOwner& owner = owners[static_cast<size_t>(it.col())];
+    const int l = owner.link;
     size_t slot = 0;
     while (slot < parts.used && parts.perLink[slot].first != l)
       ++slot;
@@ -305,7 +309,7 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
       }
       parts.perLink[parts.used++] = {l, TwistRow::Zero()};
     }
-    const int e = owners.element[static_cast<size_t>(it.col())];
+    const int e = owner.element;
     const int k = static_cast<int>(it.col()) - context_.model.elements[e].offset;
     parts.perLink[slot].second += (it.value() / norm) * context_.twistRow(e, k);
   }
@@ -341,8 +345,8 @@ void EndConnectionBound::addRowOf(Eigen::Index r, const RowParts& parts) {
     double* gram = &endGram_[at * gramSize_];
     const TwistRow& a = parts.perLink[s].second;
     for (int r1 = 0; r1 < lambda; ++r1) {
-      for (int c1 = 0; c1 < lambda; ++c1)
-        gram[r1 * lambda + c1] += a(r1) * a(c1);
+      for (int c1 = 0; c1 <= r1; ++c1)
+        *gram++ += a(r1) * a(c1);
     }
   }
   if (joint != nullptr && !twoLinks) {  // this connection's rows are not all rows of A on the end link
@@ -387,8 +391,8 @@ bool EndConnectionBound::rigidByEndsOf(const std::vector<int>& path) const {
       ++ends;
       const double* end = &endGram_[at * gramSize_];
       for (int r1 = 0; r1 < lambda; ++r1) {
-        for (int c1 = 0; c1 < lambda; ++c1)
-          gram(r1, c1) += end[r1 * lambda + c1];
+        for (int c1 = 0; c1 <= r1; ++c1)
+          gram(r1, c1) += *end++;
       }
     }
   }
@@ -439,8 +443,7 @@ void extendChain(const SearchContext& context, std::vector<int>& path, size_t bo
     return;
   for (int j : context.connectionsAt(last)) {
     const int next = context.otherLink(j, last);
-    const size_t more =
-        bodies + (context.mechanism.joints[static_cast<size_t>(j)].type == JointType::Fixed ? 0 : 1);
+    const size_t more = bodies + (context.weld[static_cast<size_t>(j)] ? 0 : 1);
     if (more > kMaxGroup || next == context.mechanism.rootLink || context.connectionsAt(next).size() != 2 ||
         std::find(path.begin(), path.end(), next) != path.end())
       continue;

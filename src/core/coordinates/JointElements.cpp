@@ -48,7 +48,7 @@ std::optional<Diagnostic> addJointElements(ModelBuilder& builder) {
       model.jointFreedom[j] = model.lambda - 1;  // one equation on the elements of the two joints it couples
       continue;
     }
-    const auto axes = worldAxes(joint, builder.poses);
+    const auto& axes = builder.axes[j];
     c.axisWorld = axes.first;
     // The connection's primitives in this mode: the joint-type table (JointTypes.cpp), or its planar form.
     if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable) {

@@ -35,10 +35,14 @@ Eigen::Vector3d ModelBuilder::worldOf(const Direction& d) const {
   return d.tail < 0 ? world[d.head] : (world[d.head] - world[d.tail]).eval();
 }
 
-std::pair<Eigen::Vector3d, Eigen::Vector3d> worldAxes(const Joint& joint, const LinkPoses& poses) {
+Eigen::Vector3d worldAxis(const Joint& joint, const LinkPoses& poses) {
   const Eigen::Matrix3d r1 = poses[joint.link1].linear() * joint.frame1.linear();
+  return r1 * joint.axis;
+}
+
+std::pair<Eigen::Vector3d, Eigen::Vector3d> worldAxes(const Joint& joint, const LinkPoses& poses) {
   const Eigen::Matrix3d r2 = poses[joint.link2].linear() * joint.frame2.linear();
-  return {r1 * joint.axis, r2 * joint.axis2};
+  return {worldAxis(joint, poses), r2 * joint.axis2};
 }
 
 }  // namespace mobility_analysis

@@ -29,7 +29,7 @@ void addRigidLinkEquations(ModelBuilder& builder) {
     const size_t numDirs = planar ? 1 : 2;
     for (size_t i = 0; i < numDirs; ++i) {
       for (size_t j = i; j < numDirs; ++j) {
-        ConstraintEquation eq;
+        ConstraintEquation& eq = model.equations.emplace_back();  // written in place, not copied in
         eq.source = EquationSource::Link;
         eq.element = static_cast<int>(b);
         eq.form = EquationForm::Dot;
@@ -44,7 +44,6 @@ void addRigidLinkEquations(ModelBuilder& builder) {
         } else {
           eq.kind = EquationKind::LinkDotProduct;
         }
-        model.equations.push_back(eq);
       }
     }
     const Eigen::Vector3d d1 = builder.directionValue(basis.d1);
@@ -68,7 +67,7 @@ void addRigidLinkEquations(ModelBuilder& builder) {
           isPoint ? (builder.coordinates(e) - builder.coordinates(basis.p0)).eval() : builder.coordinates(e);
       const Eigen::Vector3d coefficients = lu.solve(rhs);
       for (int k = 0; k < dim; ++k) {
-        ConstraintEquation eq;
+        ConstraintEquation& eq = model.equations.emplace_back();
         eq.source = EquationSource::Link;
         eq.element = static_cast<int>(b);
         eq.kind = EquationKind::LinearCombination;
@@ -81,7 +80,6 @@ void addRigidLinkEquations(ModelBuilder& builder) {
         eq.coefficients = coefficients;
         if (planar)
           eq.coefficients.z() = 0.0;
-        model.equations.push_back(eq);
       }
     }
   }

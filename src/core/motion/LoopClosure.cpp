@@ -64,6 +64,7 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
   if (maxAbs(r) <= tolerances::kAssemblyTarget) {
     result.residual = maxAbs(r);
     result.converged = true;
+    result.poses = std::move(poses);
     return result;
   }
   evaluateClosure(mechanism, layout, poses, columns, numColumns, r, &J);
@@ -121,6 +122,7 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
   }
   result.residual = maxAbs(r);
   result.converged = result.residual <= tolerances::kAssemblyTarget;
+  result.poses = std::move(poses);  // r is the residual at these poses: each accepted step set both
   return result;
 }
 
@@ -131,72 +133,77 @@ Result<ClosedConfiguration> closeLoops(const Mechanism& mechanism, const Closure
   best.configuration = start;
   int iterations = 0;
   Eigen::VectorXd change = Eigen::VectorXd::Zero(numColumns);
-  const ClosureSolve first = solveClosure(mechanism, layout, columns, numColumns, best.configuration,
-                                          tolerances::kClosureMaxIterations);
+  ClosureSolve first = solveClosure(mechanism, layout, columns, numColumns, best.configuration,
+                                    tolerances::kClosureMaxIterations);
   iterations += first.iterations;
+  if (first.converged) {
+    // The first run's end point is the answer: its poses and residual, not computed a second time.
+    best.poses = std::move(first.poses);
+    best.residual = first.residual;
+    best.iterations = iterations;
+    return best;
+  }
   double bestResidual = first.residual;
   TreeConfiguration bestAttempt = best.configuration;
-  if (!first.converged) {
-    // Restarts from perturbed starts, smallest perturbations first; of the first size that closes, the
-    // solution nearest the start (least change) wins.
-    Lcg random{0x9E3779B97F4A7C15ULL};
-    const double amplitudes[] = {0.1, 0.3, 1.0, 2.0};
-    constexpr int kSeedsPerAmplitude = 3;
-    bool closed = false;
-    int restarts = 0;
-    for (const double amplitude : amplitudes) {
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int seed = 0; seed < kSeedsPerAmplitude; ++seed) {
-        ++restarts;
-        Eigen::VectorXd perturbation(numColumns);
-        for (int k = 0; k < numColumns; ++k)
-          perturbation(k) = amplitude * random.next();
-        TreeConfiguration attempt = start;
-        applyIncrement(mechanism, layout, columns, perturbation, attempt);
-        change = perturbation;
-        const ClosureSolve solve = solveClosure(mechanism, layout, columns, numColumns, attempt,
-                                                tolerances::kClosureMaxIterations, &change);
-        iterations += solve.iterations;
-        if (solve.converged && change.norm() < nearest) {
-          nearest = change.norm();
-          best.configuration = attempt;
-          best.restarts = restarts;
-          closed = true;
-        }
-        if (!closed && solve.residual < bestResidual) {
-          bestResidual = solve.residual;
-          bestAttempt = attempt;
-        }
+  // Restarts from perturbed starts, smallest perturbations first; of the first size that closes, the
+  // solution nearest the start (least change) wins.
+  Lcg random{0x9E3779B97F4A7C15ULL};
+  const double amplitudes[] = {0.1, 0.3, 1.0, 2.0};
+  constexpr int kSeedsPerAmplitude = 3;
+  bool closed = false;
+  int restarts = 0;
+  for (const double amplitude : amplitudes) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int seed = 0; seed < kSeedsPerAmplitude; ++seed) {
+      ++restarts;
+      Eigen::VectorXd perturbation(numColumns);
+      for (int k = 0; k < numColumns; ++k)
+        perturbation(k) = amplitude * random.next();
+      TreeConfiguration attempt = start;
+      applyIncrement(mechanism, layout, columns, perturbation, attempt);
+      change = perturbation;
+      const ClosureSolve solve = solveClosure(mechanism, layout, columns, numColumns, attempt,
+                                              tolerances::kClosureMaxIterations, &change);
+      iterations += solve.iterations;
+      if (solve.converged && change.norm() < nearest) {
+        nearest = change.norm();
+        best.configuration = attempt;
+        best.restarts = restarts;
+        closed = true;
       }
-      if (closed)
+      if (!closed && solve.residual < bestResidual) {
+        bestResidual = solve.residual;
+        bestAttempt = attempt;
+      }
+    }
+    if (closed)
+      break;
+  }
+  if (!closed) {
+    const LinkPoses reached = posesOf(mechanism, layout, bestAttempt);
+    Eigen::VectorXd r;
+    evaluateClosure(mechanism, layout, reached, columns, numColumns, r, nullptr);
+    const auto [joint, residual] = largestClosureResidual(mechanism, layout, r);
+    std::string pose;
+    int listed = 0;
+    for (const auto& [name, value] : computeJointPositions(mechanism, reached)) {
+      if (listed++ == 8) {
+        pose += ", ...";
         break;
-    }
-    if (!closed) {
-      const LinkPoses reached = posesOf(mechanism, layout, bestAttempt);
-      Eigen::VectorXd r;
-      evaluateClosure(mechanism, layout, reached, columns, numColumns, r, nullptr);
-      const auto [joint, residual] = largestClosureResidual(mechanism, layout, r);
-      std::string pose;
-      int listed = 0;
-      for (const auto& [name, value] : computeJointPositions(mechanism, reached)) {
-        if (listed++ == 8) {
-          pose += ", ...";
-          break;
-        }
-        char item[96];
-        std::snprintf(item, sizeof(item), "%s%s=%.6g", listed > 1 ? ", " : "", name.c_str(), value);
-        pose += item;
       }
-      char what[200];
-      std::snprintf(
-          what, sizeof(what),
-          "the loop cannot be closed: residual %.3g m after %d iterations and %d restarts; pose reached: ",
-          residual * layout.lengthScale, iterations, restarts);
-      if (joint < 0)
-        return makeDiagnostic(mechanism.file, "robot", mechanism.name, what + pose);
-      return makeDiagnostic(mechanism.file, toString(mechanism.joints[joint].kind),
-                            mechanism.joints[joint].name, what + pose);
+      char item[96];
+      std::snprintf(item, sizeof(item), "%s%s=%.6g", listed > 1 ? ", " : "", name.c_str(), value);
+      pose += item;
     }
+    char what[200];
+    std::snprintf(
+        what, sizeof(what),
+        "the loop cannot be closed: residual %.3g m after %d iterations and %d restarts; pose reached: ",
+        residual * layout.lengthScale, iterations, restarts);
+    if (joint < 0)
+      return makeDiagnostic(mechanism.file, "robot", mechanism.name, what + pose);
+    return makeDiagnostic(mechanism.file, toString(mechanism.joints[joint].kind),
+                          mechanism.joints[joint].name, what + pose);
   }
   best.poses = posesOf(mechanism, layout, best.configuration);
   Eigen::VectorXd r;

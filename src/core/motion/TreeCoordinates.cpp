@@ -54,15 +54,16 @@ double unknownValue(const Joint& joint, const LinkPoses& poses, double lc) {
  *        turn, since its angle is read from the poses.
  */
 void addCouplingRow(const Mechanism& mechanism, const ClosureLayout& layout, const LinkPoses& poses,
-                    const Joint& coupling, const std::vector<int>& columns, int row, Eigen::VectorXd& residual,
-                    std::vector<Eigen::Triplet<double>>* triplets) {
+                    const Joint& coupling, const std::vector<int>& columns, int row,
+                    Eigen::VectorXd& residual, std::vector<Eigen::Triplet<double>>* triplets) {
   const double lc = layout.lengthScale;
   const Joint& follower = mechanism.joints[coupling.follower];
   const Joint& leader = mechanism.joints[coupling.leader];
   const double followerScale = follower.type == JointType::Prismatic ? lc : 1.0;
   const double leaderScale = leader.type == JointType::Prismatic ? lc : 1.0;
-  double r = unknownValue(follower, poses, lc) -
-             (coupling.multiplier * unknownValue(leader, poses, lc) * leaderScale + coupling.offset) / followerScale;
+  double r =
+      unknownValue(follower, poses, lc) -
+      (coupling.multiplier * unknownValue(leader, poses, lc) * leaderScale + coupling.offset) / followerScale;
   if (follower.type != JointType::Prismatic)
     r = std::remainder(r, 2.0 * M_PI);
   residual(row) = r;
@@ -195,6 +196,27 @@ int jointTwists(const Mechanism& mechanism, const ClosureLayout& layout, const L
   return 0;
 }
 
+/// Tree joint @p joint's motion at @p poses (TreeConfiguration): a one-freedom joint's kept exactly a turn
+/// about / slide along its axis (poses carry round-off), a weld's the identity.
+Eigen::Isometry3d treeMotion(const Joint& joint, const LinkPoses& poses) {
+  Eigen::Isometry3d motion =
+      (poses[joint.link1] * joint.frame1).inverse() * poses[joint.link2] * joint.frame2;
+  if (joint.type == JointType::Revolute || joint.type == JointType::Continuous) {
+    const Eigen::Vector3d v = joint.axis.unitOrthogonal();
+    const Eigen::Vector3d turned = motion.linear() * v;
+    const double angle = std::atan2(joint.axis.dot(v.cross(turned)), v.dot(turned));
+    motion = Eigen::Isometry3d::Identity();
+    motion.linear() = Eigen::AngleAxisd(angle, joint.axis).toRotationMatrix();
+  } else if (joint.type == JointType::Prismatic) {
+    const double slide = joint.axis.dot(motion.translation());
+    motion = Eigen::Isometry3d::Identity();
+    motion.translation() = slide * joint.axis;
+  } else if (joint.type == JointType::Fixed) {
+    motion = Eigen::Isometry3d::Identity();
+  }
+  return motion;
+}
+
 }  // namespace
 
 ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& written, double lengthScale) {
@@ -206,10 +228,12 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
   layout.unknownOffset.assign(numJoints, -1);
   layout.unknownCount.assign(numJoints, 0);
   layout.length.assign(numJoints, 0.0);
+  std::vector<int> parentLink(numLinks, -1);  // the walk below reads no Joint (hundreds of bytes each)
   for (int j = 0; j < numJoints; ++j) {
     const Joint& joint = mechanism.joints[j];
     if (joint.kind == ConnectionKind::TreeJoint) {
       layout.parentJoint[joint.link2] = j;
+      parentLink[joint.link2] = joint.link1;
       const int count = isOneFreedomTree(joint) ? 1 : joint.type == JointType::Fixed ? 0 : 6;
       if (count > 0) {
         layout.unknownOffset[j] = layout.numUnknowns;
@@ -222,11 +246,11 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
   std::vector<bool> placed(numLinks, false);
   std::vector<int> chain;
   placed[mechanism.rootLink] = true;
+  layout.linkOrder.reserve(numLinks);
   layout.linkOrder.push_back(mechanism.rootLink);
   for (int link = 0; link < numLinks; ++link) {
     chain.clear();
-    for (int l = link; !placed[l] && layout.parentJoint[l] >= 0;
-         l = mechanism.joints[layout.parentJoint[l]].link1)
+    for (int l = link; !placed[l] && layout.parentJoint[l] >= 0; l = parentLink[l])
       chain.push_back(l);
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
       placed[*it] = true;
@@ -273,25 +297,8 @@ TreeConfiguration configurationFromPoses(const Mechanism& mechanism, const Closu
   configuration.motions.assign(mechanism.joints.size(), Eigen::Isometry3d::Identity());
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     const Joint& joint = mechanism.joints[j];
-    if (joint.kind != ConnectionKind::TreeJoint)
-      continue;
-    Eigen::Isometry3d motion =
-        (poses[joint.link1] * joint.frame1).inverse() * poses[joint.link2] * joint.frame2;
-    // Keep a one-freedom joint's motion exactly a turn about / slide along its axis (poses carry round-off).
-    if (joint.type == JointType::Revolute || joint.type == JointType::Continuous) {
-      const Eigen::Vector3d v = joint.axis.unitOrthogonal();
-      const Eigen::Vector3d turned = motion.linear() * v;
-      const double angle = std::atan2(joint.axis.dot(v.cross(turned)), v.dot(turned));
-      motion = Eigen::Isometry3d::Identity();
-      motion.linear() = Eigen::AngleAxisd(angle, joint.axis).toRotationMatrix();
-    } else if (joint.type == JointType::Prismatic) {
-      const double slide = joint.axis.dot(motion.translation());
-      motion = Eigen::Isometry3d::Identity();
-      motion.translation() = slide * joint.axis;
-    } else if (joint.type == JointType::Fixed) {
-      motion = Eigen::Isometry3d::Identity();
-    }
-    configuration.motions[j] = motion;
+    if (joint.kind == ConnectionKind::TreeJoint)
+      configuration.motions[j] = treeMotion(joint, poses);
   }
   return configuration;
 }
@@ -307,6 +314,18 @@ LinkPoses posesOf(const Mechanism& mechanism, const ClosureLayout& layout,
     poses[link] = poses[joint.link1] * joint.frame1 * configuration.motions[j] * joint.frame2.inverse();
   }
   return poses;
+}
+
+LinkPoses reposeTree(const Mechanism& mechanism, const ClosureLayout& layout, const LinkPoses& poses) {
+  LinkPoses reposed(mechanism.links.size(), Eigen::Isometry3d::Identity());
+  for (const int link : layout.linkOrder) {
+    const int j = layout.parentJoint[link];
+    if (j < 0)
+      continue;
+    const Joint& joint = mechanism.joints[j];
+    reposed[link] = reposed[joint.link1] * joint.frame1 * treeMotion(joint, poses) * joint.frame2.inverse();
+  }
+  return reposed;
 }
 
 std::vector<int> allColumns(const ClosureLayout& layout, int& numColumns) {
