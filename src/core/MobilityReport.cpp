@@ -258,6 +258,17 @@ class JsonParts {
     std::function<void(BufferedAppender&, size_t)> item;  // item i, without the ", " before it
     size_t fixedBytes = 0, itemBytes = 0;                 // estimates
   };
+  using Writer = std::function<void(BufferedAppender&)>;
+  using ItemWriter = std::function<void(BufferedAppender&, size_t)>;
+  void addFixed(size_t bytes, Writer write);
+  /// A list field: its opening ("  \"name\": [") , its items, and its close up to the next part.
+  void addList(size_t items, size_t itemBytes, Writer open, ItemWriter item, Writer close);
+  void addHead(const MobilityReport& r);
+  void addRedundancy(const MobilityReport& r);
+  void addElements(const MobilityReport& r);
+  void addPose(const MobilityReport& r);
+  void addSelfStress(const MobilityReport& r);
+  void addTail(const MobilityReport& r);
   void writePart(BufferedAppender& out, const Part& part, size_t from, size_t to, bool open,
                  bool close) const;
 
@@ -353,35 +364,50 @@ size_t forcesBytes(const std::vector<ElementForce>& elements) {
   return bytes;
 }
 
-JsonParts::JsonParts(const MobilityReport& r) {
-  auto fixed = [&](size_t bytes, std::function<void(BufferedAppender&)> write) {
-    Part part;
-    part.open = std::move(write);
-    part.fixedBytes = bytes;
-    parts_.push_back(std::move(part));
+/// Opens a field: "  \"name\": " and the bracket.
+std::function<void(BufferedAppender&)> fieldOpen(const char* name, char bracket) {
+  return [name, bracket](BufferedAppender& out) {
+    appendField(out, name);
+    out += bracket;
   };
-  // A list field: "  \"name\": [" items "]" and what follows it up to the next part.
-  auto list = [&](size_t items, size_t itemBytes, std::function<void(BufferedAppender&)> open,
-                  std::function<void(BufferedAppender&, size_t)> item,
-                  std::function<void(BufferedAppender&)> close) {
-    Part part;
-    part.open = std::move(open);
-    part.close = std::move(close);
-    part.items = items;
-    part.item = std::move(item);
-    part.fixedBytes = 64;
-    part.itemBytes = itemBytes;
-    parts_.push_back(std::move(part));
-  };
-  auto fieldOpen = [](const char* name, char bracket) {
-    return [name, bracket](BufferedAppender& out) {
-      appendField(out, name);
-      out += bracket;
-    };
-  };
-  auto closeWith = [](const char* text) { return [text](BufferedAppender& out) { out += text; }; };
+}
 
-  fixed(1024, [&r](BufferedAppender& out) {
+std::function<void(BufferedAppender&)> closeWith(const char* text) {
+  return [text](BufferedAppender& out) { out += text; };
+}
+
+JsonParts::JsonParts(const MobilityReport& r) {
+  addHead(r);
+  addRedundancy(r);
+  addElements(r);
+  addPose(r);
+  addSelfStress(r);
+  addTail(r);
+  for (const Part& part : parts_)
+    total_ += part.fixedBytes + part.items * part.itemBytes;
+}
+
+void JsonParts::addFixed(size_t bytes, Writer write) {
+  Part part;
+  part.open = std::move(write);
+  part.fixedBytes = bytes;
+  parts_.push_back(std::move(part));
+}
+
+void JsonParts::addList(size_t items, size_t itemBytes, Writer open, ItemWriter item, Writer close) {
+  Part part;
+  part.open = std::move(open);
+  part.close = std::move(close);
+  part.items = items;
+  part.item = std::move(item);
+  part.fixedBytes = 64;
+  part.itemBytes = itemBytes;
+  parts_.push_back(std::move(part));
+}
+
+/// From "{" to the passive motions.
+void JsonParts::addHead(const MobilityReport& r) {
+  addFixed(1024, [&r](BufferedAppender& out) {
     out += "{\n";
     const std::pair<const char*, const std::string*> names[] = {
         {"robot", &r.robot}, {"file", &r.file}, {"mode", &r.mode}};
@@ -422,13 +448,17 @@ JsonParts::JsonParts(const MobilityReport& r) {
     });
     out += ",\n";
   });
-  list(
+}
+
+/// The nullity trace and the redundant constraints, joints, links and boundaries.
+void JsonParts::addRedundancy(const MobilityReport& r) {
+  addList(
       r.nullityTrace.size(), 8, fieldOpen("nullity_trace", '['),
       [&r](BufferedAppender& out, size_t i) { appendInteger(out, r.nullityTrace[i]); }, closeWith("],\n"));
   size_t constraintBytes = 96;
   for (const RedundantConstraint& c : r.redundantConstraints)
     constraintBytes += c.source.size() + c.name.size() + c.kind.size() + c.equation.size() + c.cause.size();
-  list(
+  addList(
       r.redundantConstraints.size(),
       r.redundantConstraints.empty() ? 96 : constraintBytes / r.redundantConstraints.size(),
       fieldOpen("redundant_constraints", '['),
@@ -449,7 +479,7 @@ JsonParts::JsonParts(const MobilityReport& r) {
         out += '}';
       },
       closeWith("],\n"));
-  list(
+  addList(
       r.redundantJoints.size(), 80, fieldOpen("redundant_joints", '['),
       [&r](BufferedAppender& out, size_t i) {
         const RedundantJoint& j = r.redundantJoints[i];
@@ -462,7 +492,7 @@ JsonParts::JsonParts(const MobilityReport& r) {
         out += '}';
       },
       closeWith("],\n"));
-  fixed(64 + 32 * (r.redundantLinks.size() + r.redundantBoundaries.size()), [&r](BufferedAppender& out) {
+  addFixed(64 + 32 * (r.redundantLinks.size() + r.redundantBoundaries.size()), [&r](BufferedAppender& out) {
     auto quoted = [&out](const std::string& text) { appendQuoted(out, text); };
     appendField(out, "redundant_links");
     appendList(out, r.redundantLinks, quoted);
@@ -474,13 +504,17 @@ JsonParts::JsonParts(const MobilityReport& r) {
     appendList(out, r.redundantBoundaries, quoted);
     out += ",\n";
   });
-  list(
+}
+
+/// Every link, joint and cable with its class or state.
+void JsonParts::addElements(const MobilityReport& r) {
+  addList(
       r.links.size(), 96, fieldOpen("links", '['),
       [&r](BufferedAppender& out, size_t i) { appendStatus(out, r.links[i]); }, closeWith("],\n"));
-  list(
+  addList(
       r.joints.size(), 96, fieldOpen("joints", '['),
       [&r](BufferedAppender& out, size_t i) { appendStatus(out, r.joints[i]); }, closeWith("],\n"));
-  list(
+  addList(
       r.cables.size(), 112, fieldOpen("cables", '['),
       [&r](BufferedAppender& out, size_t i) {
         const CableState& c = r.cables[i];
@@ -497,7 +531,11 @@ JsonParts::JsonParts(const MobilityReport& r) {
         out += '}';
       },
       closeWith("],\n"));
-  fixed(256, [&r](BufferedAppender& out) {
+}
+
+/// The rank margin, scale, closure, joint positions and assembly.
+void JsonParts::addPose(const MobilityReport& r) {
+  addFixed(256, [&r](BufferedAppender& out) {
     appendField(out, "rank_margin");
     out += "{\"tolerance\": ";
     appendNumber(out, r.rankMargin.tolerance, 3);
@@ -518,7 +556,7 @@ JsonParts::JsonParts(const MobilityReport& r) {
     appendNumber(out, r.closureResidualAfter, 3);
     out += "},\n";
   });
-  list(
+  addList(
       r.positions.size(), 48, fieldOpen("positions", '{'),
       [&r](BufferedAppender& out, size_t i) {
         appendQuoted(out, r.positions[i].name);
@@ -526,7 +564,7 @@ JsonParts::JsonParts(const MobilityReport& r) {
         appendNumber(out, r.positions[i].value, 12);
       },
       closeWith("},\n"));
-  fixed(128 + 16 * r.assembly.events.size(), [&r](BufferedAppender& out) {
+  addFixed(128 + 16 * r.assembly.events.size(), [&r](BufferedAppender& out) {
     appendField(out, "assembly");
     out += "{\"residual\": ";
     appendNumber(out, r.assembly.residual, 3);
@@ -538,12 +576,15 @@ JsonParts::JsonParts(const MobilityReport& r) {
     appendList(out, r.assembly.events, [&out](const std::string& text) { appendQuoted(out, text); });
     out += "},\n";
   });
-  // self_stress: its states, then its prestress, each a list of its own.
+}
+
+/// self_stress: its states, then its prestress, each a list of its own.
+void JsonParts::addSelfStress(const MobilityReport& r) {
   const SelfStressInfo& s = r.selfStress;
   size_t stateBytes = 0;
   for (const SelfStressState& state : s.states)
     stateBytes += forcesBytes(state.elements);
-  list(
+  addList(
       s.states.size(), s.states.empty() ? 0 : stateBytes / s.states.size(),
       [&s](BufferedAppender& out) {
         appendField(out, "self_stress");
@@ -556,7 +597,7 @@ JsonParts::JsonParts(const MobilityReport& r) {
         out += "], \"taut_cables\": " + std::to_string(s.tautCables) +
                ", \"prestressable\": " + (s.prestressable ? "true" : "false") + ", \"prestress\": [";
       });
-  list(
+  addList(
       s.prestress.size(), s.prestress.empty() ? 0 : forcesBytes(s.prestress) / s.prestress.size(), {},
       [&s](BufferedAppender& out, size_t i) { appendForce(out, s.prestress[i]); },
       [&s](BufferedAppender& out) {
@@ -565,15 +606,17 @@ JsonParts::JsonParts(const MobilityReport& r) {
                ", \"stability\": " + quote(s.stability) + "}";
         out += ",\n";
       });
-  fixed(256 + 64 * r.warnings.size(), [&r](BufferedAppender& out) {
+}
+
+/// The deployment, if any, the warnings and "}".
+void JsonParts::addTail(const MobilityReport& r) {
+  addFixed(256 + 64 * r.warnings.size(), [&r](BufferedAppender& out) {
     if (r.deployment)
       out += "  \"deployment\": " + deploymentJson(*r.deployment) + ",\n";
     appendField(out, "warnings");
     appendList(out, r.warnings, [&out](const std::string& text) { appendQuoted(out, text); });
     out += "\n}\n";
   });
-  for (const Part& part : parts_)
-    total_ += part.fixedBytes + part.items * part.itemBytes;
 }
 
 JsonParts::Cut JsonParts::middle() const {
