@@ -56,6 +56,111 @@ struct FillBudget {
 };
 
 /**
+ * The sweep's rule for a dependent row's stress, whoever finds and traces, and what it carries from row to
+ * row.
+ * @p find a local stress (LocalStressFinder), @p cappedTrace the dependency traced up to a limit, @p
+ * fullTrace traced whatever its length.
+ */
+class StressRule {
+ public:
+  size_t traceLimit() const { return traceLimit_; }
+
+  template <class Find, class CappedTrace, class FullTrace>
+  SelfStress resolve(const LocalStressFinder& finder, Find&& find, CappedTrace&& cappedTrace,
+                     FullTrace&& fullTrace, int& locallyResolved) {
+    // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
+    // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
+    std::optional<SelfStress> stress;
+    if (finder.inSpaceFirst() && futileFinds_ < kFutileFinds) {
+      stress = find();
+      if (stress)
+        ++locallyResolved;
+      else
+        ++futileFinds_;
+    }
+    if (!stress)
+      stress = cappedTrace(traceLimit_);
+    if (!stress && futileFinds_ < kFutileFinds) {
+      stress = find();
+      if (stress) {
+        ++locallyResolved;
+        traceLimit_ = std::max(traceLimit_, 2 * stress->size());
+        futileFinds_ = 0;
+      } else {
+        ++futileFinds_;
+      }
+    }
+    if (!stress)
+      stress = fullTrace();
+    return std::move(*stress);
+  }
+
+ private:
+  // A traced stress longer than this is found again locally; it follows the local stresses' size, so a
+  // mechanism whose loops are large is not re-solved stress by stress.
+  size_t traceLimit_ = kTraceLimit;
+  // Local searches that failed in a row. A failed search grows its ball to kLocalLimit equations and costs
+  // far more than the full trace it falls back on; where the stresses are really long (a grid of continuous
+  // bars: 1 of 19 800 stresses of the 100 x 100 grid was found locally, after 1 500 failed searches that took
+  // 80% of the whole report's time) the search stops after kFutileFinds failures in a row. One global stress
+  // among local ones (a ring's) fails once and leaves the search on.
+  int futileFinds_ = 0;
+};
+
+/// What the rule needs of a dependent row once the elimination has gone past it (finds made ahead): how many
+/// pivot rows it met, and the capped trace made at once.
+struct PassedRow {
+  int row;
+  int pivots;
+  size_t limit;  ///< of the trace made at once; 0: none made
+  std::optional<SelfStress> trace;
+};
+
+/**
+ * The rule row by row over the rows passed, as on one thread: a find made ahead from the state @p finder is
+ * in, else the finder's own; the trace made at once if its limit is the rule's, else traced again from the
+ * reduction the row had when it was added (SparseElimination::reduceOver).
+ */
+void resolvePassedRows(const SparseJacobian& J, SparseElimination& elimination,
+                       core_detail::FindsAhead& ahead, std::vector<PassedRow>& passed,
+                       LocalStressFinder& finder, StressRule& rule, SelfStressBasis& basis) {
+  finder.setState(LocalStressFinder::State{});
+  for (size_t k = 0; k < passed.size(); ++k) {
+    PassedRow& row = passed[k];
+    core_detail::FindsAhead::Find* made = ahead.finds(k);
+    auto find = [&]() -> std::optional<SelfStress> {
+      for (int f = 0; f < 2; ++f) {
+        if (made[f].made && made[f].from == finder.state()) {
+          made[f].made = false;
+          finder.setState(made[f].after);
+          return std::move(made[f].stress);
+        }
+      }
+      return finder.find(row.row);
+    };
+    bool reduced = false;
+    auto reduceAgain = [&] {
+      if (reduced)
+        return;
+      const double norm = J.row(row.row).norm();
+      elimination.reduceOver(J, row.row, norm > 0.0 ? 1.0 / norm : 0.0, row.pivots);
+      reduced = true;
+    };
+    auto cappedTrace = [&](size_t limit) {
+      if (row.limit == limit)
+        return std::move(row.trace);
+      reduceAgain();
+      return elimination.traceDependency(row.row, elimination.multipliers(), limit);
+    };
+    auto fullTrace = [&] {
+      reduceAgain();
+      return elimination.traceDependency(row.row, elimination.multipliers());
+    };
+    basis.stresses.push_back(rule.resolve(finder, find, cappedTrace, fullTrace, basis.locallyResolved));
+  }
+}
+
+/**
  * One elimination of J in @p order, tracing each dependent row's stress (locally where the trace runs long).
  * @param[in] fillBudget give up (return nothing) once the elimination has stored more entries than it allows.
  */
@@ -85,54 +190,11 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
       lazyFinder.emplace(mechanism, model, J, order, position, tolerance);
     return *lazyFinder;
   };
-  // A traced stress longer than this is found again locally; it follows the local stresses' size, so a
-  // mechanism whose loops are large is not re-solved stress by stress.
-  size_t traceLimit = kTraceLimit;
-  // Local searches that failed in a row. A failed search grows its ball to kLocalLimit equations and costs
-  // far more than the full trace it falls back on; where the stresses are really long (a grid of continuous
-  // bars: 1 of 19 800 stresses of the 100 x 100 grid was found locally, after 1 500 failed searches that took
-  // 80% of the whole report's time) the search stops after kFutileFinds failures in a row. One global stress
-  // among local ones (a ring's) fails once and leaves the search on.
-  int futileFinds = 0;
-  // The rule for a dependent row's stress, whoever finds and traces: find a local stress (LocalStressFinder),
-  // cappedTrace the dependency traced up to a limit, fullTrace traced whatever its length.
-  auto resolve = [&](auto&& find, auto&& cappedTrace, auto&& fullTrace) {
-    // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
-    // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
-    std::optional<SelfStress> stress;
-    if (finder().inSpaceFirst() && futileFinds < kFutileFinds) {
-      stress = find();
-      if (stress)
-        ++basis.locallyResolved;
-      else
-        ++futileFinds;
-    }
-    if (!stress)
-      stress = cappedTrace(traceLimit);
-    if (!stress && futileFinds < kFutileFinds) {
-      stress = find();
-      if (stress) {
-        ++basis.locallyResolved;
-        traceLimit = std::max(traceLimit, 2 * stress->size());
-        futileFinds = 0;
-      } else {
-        ++futileFinds;
-      }
-    }
-    if (!stress)
-      stress = fullTrace();
-    return std::move(*stress);
-  };
+  StressRule rule;
   // Finds made ahead on a second thread (FindsAhead.hpp), and what the rule needs of each dependent row once
-  // the elimination has gone past it: how many pivot rows it met, and the capped trace made at once.
+  // the elimination has gone past it.
   std::optional<core_detail::FindsAhead> ahead;
-  struct Passed {
-    int row;
-    int pivots;
-    size_t limit;  // of the trace made at once; 0: none made
-    std::optional<SelfStress> trace;
-  };
-  std::vector<Passed> passed;
+  std::vector<PassedRow> passed;
   const size_t progressStep = std::max<size_t>(1, order.rows.size() / 20);
   size_t rowEntries = 0;  // of the rows taken so far
   for (size_t i = 0; i < order.rows.size(); ++i) {
@@ -151,9 +213,9 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
       if (!ahead)
         ahead.emplace(LocalStressFinder::Inputs{mechanism, model, J, order, position, tolerance},
                       kFutileFinds, static_cast<size_t>(m));
-      Passed row{r, elimination.rank(), 0, std::nullopt};
+      PassedRow row{r, elimination.rank(), 0, std::nullopt};
       if (!ahead->predictsSpaceFirst()) {
-        row.limit = ahead->traceLimitHint(traceLimit);
+        row.limit = ahead->traceLimitHint(rule.traceLimit());
         row.trace = elimination.traceDependency(r, elimination.multipliers(), row.limit);
       }
       ahead->publish(r, row.trace.has_value());
@@ -165,47 +227,11 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
       return elimination.traceDependency(r, elimination.multipliers(), limit);
     };
     auto fullTrace = [&] { return elimination.traceDependency(r, elimination.multipliers()); };
-    basis.stresses.push_back(resolve(find, cappedTrace, fullTrace));
+    basis.stresses.push_back(rule.resolve(finder(), find, cappedTrace, fullTrace, basis.locallyResolved));
   }
   if (ahead) {
-    // The rule row by row, as on one thread: a find made ahead from the state the finder is in, else the
-    // finder's own; the trace made at once if its limit is the rule's, else traced again from the
-    // reduction the row had when it was added.
     ahead->finish(finder());
-    finder().setState(LocalStressFinder::State{});
-    for (size_t k = 0; k < passed.size(); ++k) {
-      Passed& row = passed[k];
-      core_detail::FindsAhead::Find* made = ahead->finds(k);
-      auto find = [&]() -> std::optional<SelfStress> {
-        for (int f = 0; f < 2; ++f) {
-          if (made[f].made && made[f].from == finder().state()) {
-            made[f].made = false;
-            finder().setState(made[f].after);
-            return std::move(made[f].stress);
-          }
-        }
-        return finder().find(row.row);
-      };
-      bool reduced = false;
-      auto reduceAgain = [&] {
-        if (reduced)
-          return;
-        const double norm = J.row(row.row).norm();
-        elimination.reduceOver(J, row.row, norm > 0.0 ? 1.0 / norm : 0.0, row.pivots);
-        reduced = true;
-      };
-      auto cappedTrace = [&](size_t limit) {
-        if (row.limit == limit)
-          return std::move(row.trace);
-        reduceAgain();
-        return elimination.traceDependency(row.row, elimination.multipliers(), limit);
-      };
-      auto fullTrace = [&] {
-        reduceAgain();
-        return elimination.traceDependency(row.row, elimination.multipliers());
-      };
-      basis.stresses.push_back(resolve(find, cappedTrace, fullTrace));
-    }
+    resolvePassedRows(J, elimination, *ahead, passed, finder(), rule, basis);
   }
   basis.rank = elimination.rank();
   basis.smallestKeptPivot = elimination.smallestKeptPivot();
