@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "LocalStressFinder.hpp"
+#include "StressRule.hpp"
 
 namespace mobility_analysis {
 namespace core_detail {
@@ -42,10 +43,8 @@ class FindsAhead {
   };
 
   /// @param[in] maxRows most dependent rows the sweep can publish (J's rows).
-  FindsAhead(const LocalStressFinder::Inputs& inputs, int futileLimit, size_t maxRows)
-      : inputs_(inputs),
-        futileLimit_(futileLimit),
-        chunks_(std::make_unique<std::unique_ptr<Slot[]>[]>(maxRows / kChunk + 1)) {}
+  FindsAhead(const LocalStressFinder::Inputs& inputs, size_t maxRows)
+      : inputs_(inputs), chunks_(std::make_unique<std::unique_ptr<Slot[]>[]>(maxRows / kChunk + 1)) {}
 
   FindsAhead(const FindsAhead&) = delete;
   FindsAhead& operator=(const FindsAhead&) = delete;
@@ -78,11 +77,8 @@ class FindsAhead {
       wake_.notify_one();
   }
 
-  /// The trace limit the sweep will have reached, as far as the worker's finds tell: twice the longest stress
-  /// it found after a failed trace (sweepBasis raises its limit so), or @p floor.
-  size_t traceLimitHint(size_t floor) const {
-    return std::max(floor, limitHint_.load(std::memory_order_relaxed));
-  }
+  /// The trace limit the sweep will have reached, as far as the worker's rule has followed it.
+  size_t traceLimitHint() const { return limitHint_.load(std::memory_order_relaxed); }
 
   /// Whether the worker's latest find put the finder in space-first mode (the sweep then need not trace at
   /// once: it finds before it traces).
@@ -119,13 +115,12 @@ class FindsAhead {
 
   /// Finds made ahead for the @p k-th published row (valid after finish()): at most two, in the order made.
   Find* finds(size_t k) { return at(k).finds; }
-  size_t count() const { return published_.load(std::memory_order_relaxed); }
 
  private:
   static constexpr size_t kChunk = 4096;
   static constexpr size_t kWakeEvery = 64;
-  static constexpr size_t kWarmUp =
-      16;  ///< rows the worker finds before the sweep's thread guesses its state
+  /// Rows the worker finds before the sweep's thread guesses its state.
+  static constexpr size_t kWarmUp = 16;
   enum Status : int { kFree = 0, kFront = 1, kBack = 2, kDone = 3 };
 
   struct Slot {
@@ -171,11 +166,13 @@ class FindsAhead {
     finished_.store(true, std::memory_order_release);
   }
 
-  /// The published rows from the front, following the sweep's rule (sweepBasis) for which rows it finds and
-  /// from which state, with what it knows of the sweep's traces.
+  /// The published rows from the front, following the sweep's rule (StressRule) for which rows it finds and
+  /// from which state, with what it knows of the sweep's traces: whether the trace made at once succeeded
+  /// (a stand-in stress when it did; the rule's full trace, never used, an empty one).
   void findFromTheFront() {
     LocalStressFinder finder(inputs_);
-    int futile = 0;
+    StressRule rule;
+    int locallyResolved = 0;  // the sweep counts its own
     for (size_t k = 0;; ++k) {
       if (k >= published_.load(std::memory_order_acquire)) {
         std::unique_lock<std::mutex> lock(mutex_);
@@ -189,24 +186,17 @@ class FindsAhead {
       int expected = kFree;
       if (!slot.status.compare_exchange_strong(expected, kFront))
         return;  // the sweep's thread has it, and everything after it
-      bool found = false;
       int made = 0;
-      if (finder.inSpaceFirst() && futile < futileLimit_) {
-        findInto(finder, slot, finder.state(), made++);
-        found = slot.finds[0].stress.has_value();
-        if (!found)
-          ++futile;
-      }
-      if (!found && !slot.traced && futile < futileLimit_) {
-        findInto(finder, slot, finder.state(), made++);
-        found = slot.finds[made - 1].stress.has_value();
-        futile = found ? 0 : futile + 1;
-        if (found) {
-          const size_t limit = 2 * slot.finds[made - 1].stress->size();
-          if (limit > limitHint_.load(std::memory_order_relaxed))
-            limitHint_.store(limit, std::memory_order_relaxed);
-        }
-      }
+      auto find = [&] {
+        findInto(finder, slot, finder.state(), made);
+        return slot.finds[made++].stress;
+      };
+      auto cappedTrace = [&](size_t) {
+        return slot.traced ? std::optional<SelfStress>(SelfStress{}) : std::nullopt;
+      };
+      rule.resolve(
+          finder, find, cappedTrace, [] { return SelfStress{}; }, locallyResolved);
+      limitHint_.store(rule.traceLimit(), std::memory_order_relaxed);
       {
         std::lock_guard<std::mutex> lock(stateMutex_);
         latest_ = finder.state();
@@ -218,13 +208,12 @@ class FindsAhead {
   }
 
   const LocalStressFinder::Inputs inputs_;
-  int futileLimit_;
   /// Slots in chunks of kChunk, the chunk table sized for every row at once: a published slot never moves.
   std::unique_ptr<std::unique_ptr<Slot[]>[]> chunks_;
   std::atomic<size_t> published_{0};
   std::atomic<bool> stop_{false};
   std::atomic<bool> spaceFirst_{false};
-  std::atomic<size_t> limitHint_{0};
+  std::atomic<size_t> limitHint_{kTraceLimit};
   std::atomic<size_t> doneFront_{0};
   std::atomic<bool> finished_{false};
   bool started_ = false;  ///< the sweep's thread only

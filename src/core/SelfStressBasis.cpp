@@ -11,16 +11,14 @@
 #include "LocalStressFinder.hpp"
 #include "SideTask.hpp"
 #include "StressMatrix.hpp"
+#include "StressRule.hpp"
 
 namespace mobility_analysis {
 
 namespace {
 
-using core_detail::kTraceLimit;
 using core_detail::LocalStressFinder;
-
-/// Local searches that may fail in a row before the basis stops searching locally (see futileFinds).
-constexpr int kFutileFinds = 8;
+using core_detail::StressRule;
 
 /// The sweep from the ground is abandoned once it has stored this many times the entries of the rows it has
 /// taken so far, plus kFillFloor; the leaves-first sweep after it, this many times all of J's entries, plus
@@ -53,58 +51,6 @@ struct FillBudget {
     return (entries > 0 && stored > entries) ||
            (perRowEntry > 0 && stored > perRowEntry * rowEntries + floor);
   }
-};
-
-/**
- * The sweep's rule for a dependent row's stress, whoever finds and traces, and what it carries from row to
- * row.
- * @p find a local stress (LocalStressFinder), @p cappedTrace the dependency traced up to a limit, @p
- * fullTrace traced whatever its length.
- */
-class StressRule {
- public:
-  size_t traceLimit() const { return traceLimit_; }
-
-  template <class Find, class CappedTrace, class FullTrace>
-  SelfStress resolve(const LocalStressFinder& finder, Find&& find, CappedTrace&& cappedTrace,
-                     FullTrace&& fullTrace, int& locallyResolved) {
-    // Where the balls in space have taken over (a grid of continuous bars), the sweep's traces run along
-    // whole rows of cells and mostly reach the trace limit before they are dropped: the ball goes first.
-    std::optional<SelfStress> stress;
-    if (finder.inSpaceFirst() && futileFinds_ < kFutileFinds) {
-      stress = find();
-      if (stress)
-        ++locallyResolved;
-      else
-        ++futileFinds_;
-    }
-    if (!stress)
-      stress = cappedTrace(traceLimit_);
-    if (!stress && futileFinds_ < kFutileFinds) {
-      stress = find();
-      if (stress) {
-        ++locallyResolved;
-        traceLimit_ = std::max(traceLimit_, 2 * stress->size());
-        futileFinds_ = 0;
-      } else {
-        ++futileFinds_;
-      }
-    }
-    if (!stress)
-      stress = fullTrace();
-    return std::move(*stress);
-  }
-
- private:
-  // A traced stress longer than this is found again locally; it follows the local stresses' size, so a
-  // mechanism whose loops are large is not re-solved stress by stress.
-  size_t traceLimit_ = kTraceLimit;
-  // Local searches that failed in a row. A failed search grows its ball to kLocalLimit equations and costs
-  // far more than the full trace it falls back on; where the stresses are really long (a grid of continuous
-  // bars: 1 of 19 800 stresses of the 100 x 100 grid was found locally, after 1 500 failed searches that took
-  // 80% of the whole report's time) the search stops after kFutileFinds failures in a row. One global stress
-  // among local ones (a ring's) fails once and leaves the search on.
-  int futileFinds_ = 0;
 };
 
 /// What the rule needs of a dependent row once the elimination has gone past it (finds made ahead): how many
@@ -212,10 +158,10 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
     if (findAhead) {
       if (!ahead)
         ahead.emplace(LocalStressFinder::Inputs{mechanism, model, J, order, position, tolerance},
-                      kFutileFinds, static_cast<size_t>(m));
+                      static_cast<size_t>(m));
       PassedRow row{r, elimination.rank(), 0, std::nullopt};
       if (!ahead->predictsSpaceFirst()) {
-        row.limit = ahead->traceLimitHint(rule.traceLimit());
+        row.limit = ahead->traceLimitHint();
         row.trace = elimination.traceDependency(r, elimination.multipliers(), row.limit);
       }
       ahead->publish(r, row.trace.has_value());
