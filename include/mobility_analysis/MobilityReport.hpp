@@ -1,5 +1,6 @@
 #pragma once
 
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <vector>
@@ -187,6 +188,13 @@ std::optional<Diagnostic> checkReport(const MobilityReport& report);
 /// @return toJson(report, sideThread) once checkReport holds, else its Diagnostic: a report is only written
 /// when sound.
 Result<std::string> writeJson(const MobilityReport& report, bool sideThread = true);
+/**
+ * @brief writeJson to @p out, written as it is made: the text never exists whole in memory (a 10^6-link
+ *        chain's is 215 MB), and nothing is written when checkReport refuses the report.
+ * @return Nothing once written (the stream's own state tells whether it took it all), else checkReport's
+ *         Diagnostic.
+ */
+std::optional<Diagnostic> writeJson(const MobilityReport& report, std::ostream& out, bool sideThread = true);
 
 /// @return toText(report) once checkReport holds, else its Diagnostic.
 Result<std::string> writeText(const MobilityReport& report);

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <ostream>
 #include <sstream>
 #include <vector>
 
@@ -35,10 +36,16 @@ namespace {
  */
 class BufferedAppender {
  public:
-  explicit BufferedAppender(std::string& out) : out_(out) {}
+  /// With @p stream, @p out is only a chunk: passed on to the stream whenever it holds kStreamChunk bytes,
+  /// and at the end.
+  explicit BufferedAppender(std::string& out, std::ostream* stream = nullptr) : out_(out), stream_(stream) {}
   BufferedAppender(const BufferedAppender&) = delete;
   BufferedAppender& operator=(const BufferedAppender&) = delete;
-  ~BufferedAppender() { flush(); }
+  ~BufferedAppender() {
+    flush();
+    if (stream_)
+      passOn();
+  }
 
   void append(const char* data, size_t size) {
     if (used_ + size > sizeof(buffer_)) {
@@ -69,12 +76,23 @@ class BufferedAppender {
   }
 
  private:
+  // Why chunks of a megabyte: few enough writes, and a report of any size touches no more fresh memory than
+  // that (a 200 x 200 braced lattice's text is 82 MB, a 10^6-link chain's 215 MB).
+  static constexpr size_t kStreamChunk = size_t{1} << 20;
+
   void flush() {
     out_.append(buffer_, used_);
     used_ = 0;
+    if (stream_ && out_.size() >= kStreamChunk)
+      passOn();
+  }
+  void passOn() {
+    stream_->write(out_.data(), static_cast<std::streamsize>(out_.size()));
+    out_.clear();
   }
 
   std::string& out_;
+  std::ostream* stream_;
   char buffer_[4096];
   size_t used_ = 0;
 };
@@ -248,8 +266,9 @@ class JsonParts {
   /// About half of the estimated bytes on either side.
   Cut middle() const;
   size_t estimatedBytes() const { return total_; }
-  /// Appends the text from @p from to @p to.
-  void write(std::string& text, Cut from, Cut to) const;
+  /// Appends the text from @p from to @p to; with @p stream, writes it there, @p text holding a chunk at a
+  /// time.
+  void write(std::string& text, Cut from, Cut to, std::ostream* stream = nullptr) const;
 
  private:
   struct Part {
@@ -317,6 +336,27 @@ std::string core_detail::toJson(const MobilityReport& r, size_t secondThreadFrom
   parts.write(text, parts.begin(), middle);
   text += secondHalf.get();
   return text;
+}
+
+void core_detail::writeJson(const MobilityReport& r, std::ostream& out, size_t secondThreadFrom) {
+  // As toJson, but the text goes to the stream as it is written instead of into one string: the first half
+  // never exists whole, and the second (when on another thread) only until it is written.
+  const JsonParts parts(r);
+  std::string chunk;
+  if (parts.estimatedBytes() < secondThreadFrom) {
+    parts.write(chunk, parts.begin(), parts.end(), &out);
+    return;
+  }
+  const JsonParts::Cut middle = parts.middle();
+  core_detail::SideTask secondHalf(true, [&] {
+    std::string half;
+    half.reserve(parts.estimatedBytes() / 2 + parts.estimatedBytes() / 16);
+    parts.write(half, middle, parts.end());
+    return half;
+  });
+  parts.write(chunk, parts.begin(), middle, &out);
+  const std::string half = secondHalf.get();
+  out.write(half.data(), static_cast<std::streamsize>(half.size()));
 }
 
 namespace {
@@ -636,8 +676,8 @@ JsonParts::Cut JsonParts::middle() const {
   return end();
 }
 
-void JsonParts::write(std::string& text, Cut from, Cut to) const {
-  BufferedAppender out(text);
+void JsonParts::write(std::string& text, Cut from, Cut to, std::ostream* stream) const {
+  BufferedAppender out(text, stream);
   // A cut {p, 0} is before part p; a cut {p, i > 0} inside its list, after its opening and i items.
   const size_t endPart = std::min(parts_.size(), to.item > 0 ? to.part + 1 : to.part);
   for (size_t p = from.part; p < endPart; ++p) {
@@ -830,6 +870,13 @@ Result<std::string> writeJson(const MobilityReport& report, bool sideThread) {
   if (std::optional<Diagnostic> d = checkReport(report))
     return *d;
   return toJson(report, sideThread);
+}
+
+std::optional<Diagnostic> writeJson(const MobilityReport& report, std::ostream& out, bool sideThread) {
+  if (std::optional<Diagnostic> d = checkReport(report))
+    return d;
+  core_detail::writeJson(report, out, sideThread ? kJsonSideThreadBytes : std::numeric_limits<size_t>::max());
+  return std::nullopt;
 }
 
 Result<std::string> writeText(const MobilityReport& report) {

@@ -184,12 +184,20 @@ int main(int argc, char** argv) {
                                                   : deployMechanism(valueOf(mechanism), deployment);
     if (!isOk(analysis))
       return fail(diagnosticOf(analysis).toString());
-    // The report is written only once its own invariants hold (finite numbers, consistent counts).
-    const Result<std::string> out =
-        a.json ? writeJson(valueOf(analysis).report, !a.oneThread) : writeText(valueOf(analysis).report);
-    if (!isOk(out))
-      return fail(diagnosticOf(out).toString());
-    std::cout << valueOf(out);
+    // The report is written only once its own invariants hold (finite numbers, consistent counts); the JSON
+    // goes out as it is written (a large report's text never exists whole).
+    if (a.json) {
+      if (const std::optional<Diagnostic> refused =
+              writeJson(valueOf(analysis).report, std::cout, !a.oneThread))
+        return fail(refused->toString());
+    } else {
+      const Result<std::string> out = writeText(valueOf(analysis).report);
+      if (!isOk(out))
+        return fail(diagnosticOf(out).toString());
+      std::cout << valueOf(out);
+    }
+    if (!std::cout.flush())
+      return fail("mobility_report: could not write the report to standard output");
     return 0;
   } catch (const std::exception& e) {
     return fail(std::string("mobility_report: internal error: ") + e.what());

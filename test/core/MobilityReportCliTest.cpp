@@ -1,4 +1,5 @@
 /// The CLI as a user runs it: exit codes, stdout only on success, one line on stderr on bad input.
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -37,6 +38,17 @@ TEST(MobilityReportCli, OneThreadGivesTheSameReport) {
   EXPECT_EQ(one.status, 0) << one.err;
   EXPECT_GT(one.out.size(), 1000000u);
   EXPECT_TRUE(one.out == two.out);
+}
+
+TEST(MobilityReportCli, AReportThatCannotBeWrittenExitsTwo) {
+  // The JSON goes to standard output as it is written; a full disk (/dev/full) is the user's error to see,
+  // with one line and exit 2, as for bad input, not a silent exit 0 with a truncated report.
+  for (const char* format : {" --json", ""}) {
+    const CliRun run = runReport(fixturePath("four_bar_closed.urdf") + format + " >/dev/full");
+    EXPECT_EQ(run.status, 2) << format;
+    EXPECT_NE(run.err.find("could not write the report"), std::string::npos) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  }
 }
 
 TEST(MobilityReportCli, PositionsAreUsed) {

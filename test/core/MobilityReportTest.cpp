@@ -2,6 +2,7 @@
 
 #include <limits>
 #include <regex>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -129,4 +130,33 @@ TEST(MobilityReport, JsonInTwoHalvesIsTheSameText) {
     const MobilityReport r = analyzeOrFail(urdfPath(file), AnalysisMode::Auto).report;
     EXPECT_EQ(core_detail::toJson(r, 0), core_detail::toJson(r, std::numeric_limits<size_t>::max())) << file;
   }
+}
+
+TEST(MobilityReport, JsonWrittenToAStreamIsTheSameText) {
+  // writeJson to a stream passes the text on a chunk (1 MB) at a time as it is written, on one thread or
+  // with the second half made on another: the stream must receive toJson's text whatever the size, and
+  // wherever a chunk ends (the 60 000 links and states here are several chunks).
+  for (const char* which : {"links", "states", "positions", "none"}) {
+    for (size_t n : {0, 5, 60000}) {
+      SCOPED_TRACE(std::string(which) + " " + std::to_string(n));
+      const MobilityReport r = reportWithLong(which, n);
+      const std::string expected = core_detail::toJson(r, std::numeric_limits<size_t>::max());
+      for (size_t secondThreadFrom : {size_t{0}, std::numeric_limits<size_t>::max()}) {
+        std::ostringstream out;
+        core_detail::writeJson(r, out, secondThreadFrom);
+        EXPECT_EQ(out.str(), expected);
+      }
+      std::ostringstream out;
+      EXPECT_FALSE(writeJson(r, out).has_value());
+      EXPECT_EQ(out.str(), expected);
+    }
+  }
+  // A report writeJson refuses: its Diagnostic, and not a byte written.
+  MobilityReport bad = reportWithLong("links", 100);
+  bad.characteristicLength = std::numeric_limits<double>::quiet_NaN();
+  std::ostringstream out;
+  const std::optional<Diagnostic> refused = writeJson(bad, out);
+  ASSERT_TRUE(refused.has_value());
+  EXPECT_NE(refused->what.find("characteristic_length"), std::string::npos) << refused->toString();
+  EXPECT_TRUE(out.str().empty());
 }
