@@ -84,17 +84,32 @@ SparseJacobian toMatrix(const std::vector<const RowsWritten*>& parts, int numCol
   return matrix;
 }
 
+/// Rows whose entries set the room reserved for the rest (writeRows).
+constexpr int kSampledRows = 1024;
+
 /// The rows [@p first, @p last) of the Jacobian, written in order, each from its own equation's few entries.
 RowsWritten writeRows(const CoordinateModel& model, const ElementView& view, int first, int last) {
   RowsWritten rows;
   rows.rowStart.reserve(static_cast<size_t>(last - first) + 1);
   GradientSink entries;
-  for (int i = first; i < last; ++i) {
-    const ConstraintEquation& eq = model.equations[i];
-    entries.clear();
-    visitForm(eq.form, [&](auto form) { form.gradient(view, eq, i, entries); });
-    appendRow(entries, rows);
-  }
+  auto write = [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      const ConstraintEquation& eq = model.equations[i];
+      entries.clear();
+      visitForm(eq.form, [&](auto form) { form.gradient(view, eq, i, entries); });
+      appendRow(entries, rows);
+    }
+  };
+  // Room for all the entries at once, from the first rows' count per row with a margin: grown by doubling
+  // instead, the entries of a large model are copied about once more and touch about twice their memory in
+  // fresh pages (what is reserved and never written is never touched).
+  const int sampled = std::min(last, first + kSampledRows);
+  write(first, sampled);
+  const size_t perRow = rows.columns.size() / static_cast<size_t>(std::max(1, sampled - first)) + 1;
+  const size_t expected = rows.columns.size() + 2 * perRow * static_cast<size_t>(last - sampled);
+  rows.columns.reserve(expected);
+  rows.values.reserve(expected);
+  write(sampled, last);
   return rows;
 }
 
