@@ -14,6 +14,8 @@
 
 #include "../SideTask.hpp"
 #include "NameIndex.hpp"
+#include "UrdfHalves.hpp"
+#include "XmlHalves.hpp"
 #include "XmlValues.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
@@ -183,19 +185,28 @@ class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) { mechanism_.file = file_; }
 
-  Mechanism read(Element robot) {
+  /// The mechanism of the <robot> element @p robot; with @p rest, of the two halves of one (XmlHalves): the
+  /// children of @p robot, then those of @p rest.
+  Mechanism read(Element robot, Element rest = Element()) {
     const char* robotName = attributeOf(robot, "name");
     mechanism_.name = robotName == nullptr ? "" : robotName;
+    const std::array<Element, 2> parts{robot, rest};
+    auto forEachTopLevel = [&](auto&& use) {
+      for (Element part : parts) {
+        for (Element e = part ? firstChildElement(part) : Element(); e; e = nextSiblingElement(e))
+          use(e);
+      }
+    };
     // One walk over the top-level elements sorts them by kind (document order within each kind) and warns
     // about the unknown ones; each kind is then read in the equation order of DESIGN.md §3.
     std::array<std::vector<Element>, kIgnored> byKind;
-    for (Element e = firstChildElement(robot); e; e = nextSiblingElement(e)) {
+    forEachTopLevel([&](Element e) {
       const TopLevel kind = classify(e.name());
       if (kind == kUnknown)
         warnUnknown(e);
       else if (kind != kIgnored)
         byKind[kind].push_back(e);
-    }
+    });
     mechanism_.links.reserve(byKind[kLink].size());
     linkIndex_.reserve(byKind[kLink].size());
     size_t connections = 0;
@@ -214,11 +225,11 @@ class Reader {
     std::vector<Element>& loops = byKind[kLoopJoint];
     if (!byKind[kLoop].empty()) {
       loops.clear();
-      for (Element e = firstChildElement(robot); e; e = nextSiblingElement(e)) {
+      forEachTopLevel([&](Element e) {
         const TopLevel kind = classify(e.name());
         if (kind == kLoopJoint || kind == kLoop)
           loops.push_back(e);
-      }
+      });
     }
     for (Element e : loops)
       readLoop(e);
@@ -768,6 +779,17 @@ std::optional<XmlFault> wellFormedError(const pugi::xml_document& document) {
   return walker.fault;
 }
 
+/// The mechanism of the <robot> element @p robot (with @p rest: of its two halves, Reader::read).
+Result<Mechanism> readRobot(Element robot, Element rest, const std::string& file) {
+  if (!robot)
+    return makeDiagnostic(file, "xml", "", "the root element is not <robot>");
+  try {
+    return Reader(file).read(robot, rest);
+  } catch (const ReadFailure& failure) {
+    return failure.diagnostic;
+  }
+}
+
 /// The mechanism of a parsed document (@p parsed: pugixml's answer; @p textAsWritten() gives the text for the
 /// line of an error).
 template <class TextAsWritten>
@@ -781,16 +803,7 @@ Result<Mechanism> readDocument(const pugi::xml_document& document, const pugi::x
   };
   if (!parsed)
     return refuse(XmlFault{parsed.description(), parsed.offset});
-  auto readTree = [&]() -> Result<Mechanism> {
-    const Element robot = document.child("robot");
-    if (!robot)
-      return makeDiagnostic(file, "xml", "", "the root element is not <robot>");
-    try {
-      return Reader(file).read(robot);
-    } catch (const ReadFailure& failure) {
-      return failure.diagnostic;
-    }
-  };
+  auto readTree = [&] { return readRobot(document.child("robot"), Element(), file); };
   auto walk = [&] { return wellFormedError(document); };
   if (!sideThread) {
     if (const std::optional<XmlFault> found = walk())
@@ -807,18 +820,25 @@ Result<Mechanism> readDocument(const pugi::xml_document& document, const pugi::x
   return mechanism;
 }
 
-}  // namespace
+/// From this size of file on, a second thread may parse half of it (io_detail::parseInHalves): about 10 ms of
+/// parsing each, against tens of microseconds to start a thread.
+constexpr size_t kHalvesBytes = size_t{4} << 20;
 
-Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName, bool sideThread) {
-  pugi::xml_document document;
-  const pugi::xml_parse_result parsed = document.load_buffer(urdfText.data(), urdfText.size(), kParseOptions);
-  const bool besideReader = sideThread && urdfText.size() >= kSideThreadBytes;
-  return readDocument(
-      document, parsed, io_detail::baseName(fileName), [&]() -> const std::string& { return urdfText; },
-      besideReader);
+/**
+ * The mechanism of a file parsed in two halves, or nothing when the walk for what pugixml lets through finds
+ * a fault in either: the whole document is read then, and its walk names the fault at its line.
+ */
+std::optional<Result<Mechanism>> readHalves(const io_detail::XmlHalves& halves, const std::string& file) {
+  core_detail::SideTask<bool> faulty(
+      true, [&] { return wellFormedError(halves.first) || wellFormedError(halves.second); });
+  Result<Mechanism> mechanism = readRobot(halves.first.child("robot"), halves.second.child("robot"), file);
+  if (faulty.get())
+    return std::nullopt;
+  return mechanism;
 }
 
-Result<Mechanism> readUrdfFile(const std::string& path, bool sideThread) {
+/// The file read whole, in one buffer.
+Result<Mechanism> readWholeUrdfFile(const std::string& path, bool sideThread) {
   // The text once in memory: the parser works in this buffer (names and values point into it).
   std::string text;
   if (!io_detail::readWholeFile(path, text))
@@ -834,6 +854,44 @@ Result<Mechanism> readUrdfFile(const std::string& path, bool sideThread) {
         return original;
       },
       besideReader);
+}
+
+/// The file read from its two halves where it can be cut (from byte @p cutFrom on, by default its middle),
+/// else whole; @p cut, when given, is set to where it was cut (0: read whole).
+Result<Mechanism> readUrdfFileFrom(const std::string& path, bool sideThread, size_t halvesFrom,
+                                   std::optional<size_t> cutFrom, size_t* cut) {
+  if (cut != nullptr)
+    *cut = 0;
+  if (sideThread) {
+    if (const std::unique_ptr<io_detail::XmlHalves> halves =
+            io_detail::parseInHalves(path, kParseOptions, "robot", halvesFrom, cutFrom)) {
+      if (std::optional<Result<Mechanism>> mechanism = readHalves(*halves, io_detail::baseName(path))) {
+        if (cut != nullptr)
+          *cut = halves->cut;
+        return std::move(*mechanism);
+      }
+    }
+  }
+  return readWholeUrdfFile(path, sideThread);
+}
+
+}  // namespace
+
+Result<Mechanism> readUrdf(const std::string& urdfText, const std::string& fileName, bool sideThread) {
+  pugi::xml_document document;
+  const pugi::xml_parse_result parsed = document.load_buffer(urdfText.data(), urdfText.size(), kParseOptions);
+  const bool besideReader = sideThread && urdfText.size() >= kSideThreadBytes;
+  return readDocument(
+      document, parsed, io_detail::baseName(fileName), [&]() -> const std::string& { return urdfText; },
+      besideReader);
+}
+
+Result<Mechanism> readUrdfFile(const std::string& path, bool sideThread) {
+  return readUrdfFileFrom(path, sideThread, kHalvesBytes, std::nullopt, nullptr);
+}
+
+Result<Mechanism> core_detail::readUrdfFileCutFrom(const std::string& path, size_t cutFrom, size_t* cut) {
+  return readUrdfFileFrom(path, true, 0, cutFrom, cut);
 }
 
 }  // namespace mobility_analysis
