@@ -203,14 +203,12 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
     return eq.source == EquationSource::Joint ? mechanism.joints[eq.element].name
                                               : mechanism.links[eq.element].name;
   };
-  std::vector<int> jointEquations(mechanism.joints.size(), 0), jointRedundant(mechanism.joints.size(), 0);
+  std::vector<int> jointRedundant(mechanism.joints.size(), 0);
   std::set<std::string> redundantBoundaries;
   for (int r = 0; r < model.numConstraints(); ++r) {
-    const ConstraintEquation& eq = model.equations[r];
-    if (eq.source == EquationSource::Joint)
-      ++jointEquations[eq.element];
     if (!ranks.redundant[r])
       continue;
+    const ConstraintEquation& eq = model.equations[r];
     // A coupling's equation is a joint equation in the phases, but the report names its own source kind.
     const bool coupling =
         eq.source == EquationSource::Joint && mechanism.joints[eq.element].kind == ConnectionKind::Coupling;
@@ -229,6 +227,15 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   }
   report.numRedundant = static_cast<int>(report.redundantConstraints.size());
   report.redundantBoundaries.assign(redundantBoundaries.begin(), redundantBoundaries.end());
+  // Each redundant joint's number of equations, counted only when there is one: the count reads every
+  // equation (a chain of 10^5 links: 5 10^5 of them, 48 MB read in 8 ms).
+  std::vector<int> jointEquations(mechanism.joints.size(), 0);
+  if (std::any_of(jointRedundant.begin(), jointRedundant.end(), [](int n) { return n > 0; })) {
+    for (const ConstraintEquation& eq : model.equations) {
+      if (eq.source == EquationSource::Joint)
+        ++jointEquations[eq.element];
+    }
+  }
   for (size_t j = 0; j < mechanism.joints.size(); ++j) {
     if (jointRedundant[j] > 0) {
       report.redundantJoints.push_back(
