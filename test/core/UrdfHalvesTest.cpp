@@ -186,6 +186,7 @@ TEST(UrdfHalves, aFaultyFileGivesTheSameErrorWhereverItIsCut) {
       {good.substr(0, tail) + "  <link name=\"a\" name=\"b\"/>\n" + good.substr(tail), "twice"},
       {good + "text after", "text outside"},
       {good.substr(0, good.find("</robot>")), "mismatch"},
+      {good.substr(0, good.find("<!-- after")) + "  <link name=\"late\"/>\n</robot>\n", "mismatch"},
       {good.substr(0, tail) + "  <link name=\"x\"><bad</link>\n" + good.substr(tail), "xml"},
       {good.substr(0, tail) +
            "  <joint name=\"lost\" type=\"fixed\"><parent link=\"nowhere\"/><child link=\"tip\"/></joint>\n" +
