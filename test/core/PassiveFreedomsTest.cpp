@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "TextFile.hpp"
 #include "core/TestModels.hpp"
 
 using namespace mobility_analysis;
@@ -253,5 +254,53 @@ TEST(PassiveFreedoms, endConnectionBoundSettlesEveryGroupOfASerialChain) {
     EXPECT_EQ(fast.groupsRigidByEnds, 39 + 38 + 37);
     EXPECT_EQ(fast.groupsSearched, 0);
     EXPECT_EQ(full.groupsSearched, 39 + 38 + 37);
+  }
+}
+
+namespace {
+
+/// @p urdf with its root link welded, at @p offset (and turned), to a new root: the same mechanism far from
+/// the origin of the model.
+std::string placedAt(const std::string& urdf, const std::string& offset) {
+  const size_t root = urdf.find("<link name=\"");
+  const size_t nameStart = root + 12;
+  const std::string name = urdf.substr(nameStart, urdf.find('"', nameStart) - nameStart);
+  return urdf.substr(0, root) +
+         "<link name=\"far_world\"/><joint name=\"far\" type=\"fixed\"><parent link=\"" +
+         "far_world\"/><child link=\"" + name + "\"/><origin xyz=\"" + offset +
+         "\" rpy=\"0.3 0.2 0.1\"/></joint>\n" + urdf.substr(root);
+}
+
+}  // namespace
+
+TEST(PassiveFreedoms, aMechanismFarFromTheOriginHasTheSameIdleMotionsAndBound) {
+  // A group's twists are taken about a point of the group, not the origin of the model: far from it a twist
+  // about the origin mixed lengths of 10^5 with lengths of 1, the end-connection bound could not settle a
+  // single group of a chain 10^4 m away and the search was left to decide each one. Near and far, the same
+  // idle motions, every chain group settled by the bound, and the full search agreeing.
+  std::string chain = straightChainUrdf(40);
+  chain.replace(chain.find("<origin xyz='0.1 0 0'/>"), 23, "<origin xyz='10000 20000 0'/>");
+  const Result<Mechanism> far = loadMechanismFromString(chain, "far_chain.urdf");
+  ASSERT_TRUE(isOk(far));
+  for (AnalysisMode mode : {AnalysisMode::Planar, AnalysisMode::Spatial}) {
+    const PassiveFreedoms fast = searchPassive(valueOf(far), mode, true);
+    EXPECT_EQ(fast.dof, 0);
+    EXPECT_EQ(fast.groupsRigidByEnds, 39 + 38 + 37);
+    EXPECT_EQ(fast.groupsSearched, 0);
+  }
+  for (const char* file : {"delta_robot.urdf", "rssr.urdf"}) {
+    const Mechanism near = loadOrFail(urdfPath(file));
+    const Result<Mechanism> moved =
+        loadMechanismFromString(placedAt(readTextFile(urdfPath(file)), "300 -200 100"), file);
+    ASSERT_TRUE(isOk(moved)) << diagnosticOf(moved).toString();
+    const PassiveFreedoms a = searchPassive(near, AnalysisMode::Spatial, true);
+    const PassiveFreedoms b = searchPassive(valueOf(moved), AnalysisMode::Spatial, true);
+    EXPECT_GT(a.dof, 0) << file;
+    EXPECT_EQ(b.dof, a.dof) << file;
+    ASSERT_EQ(b.motions.size(), a.motions.size()) << file;
+    for (size_t k = 0; k < a.motions.size(); ++k)
+      EXPECT_EQ(b.motions[k].description, a.motions[k].description) << file << " motion " << k;
+    EXPECT_EQ(b.groupsRigidByEnds, a.groupsRigidByEnds) << file;
+    expectSameAnswer(valueOf(moved), AnalysisMode::Spatial, std::string(file) + " far");
   }
 }

@@ -115,9 +115,15 @@ struct SearchContext {
 
   /// Element @p e's point or unit vector at q (z = 0 in the plane).
   Eigen::Vector3d element3(int e) const;
-  /// The row of T for coordinate @p k of element @p e: d(x_k)/d(omega, v), from -[x]x and (points) I; in
-  /// the plane the components omega_z, v_x, v_y.
-  TwistRow twistRow(int e, int k) const;
+  /// The row of T for coordinate @p k of element @p e: d(x_k)/d(omega, v) for the twist (omega, v) about
+  /// the point @p about, from -[x - about]x (a point; -[x]x for a unit vector) and (points) I; in the plane
+  /// the components omega_z, v_x, v_y.
+  TwistRow twistRow(int e, int k, const Eigen::Vector3d& about) const;
+  /// The point a group's twists are taken about: its link @p l's first point (the origin when it has none).
+  /// Why not the origin of the model: far from it (a chain of 10^6 links is 10^5 m long) a twist about the
+  /// origin mixes lengths of 10^5 with lengths of 1, its rows of T lose the digits the nullity test and the
+  /// end-connection bound read, and every group went through the full search (3.6 s on that chain).
+  const Eigen::Vector3d& twistOrigin(int l) const { return twistOrigin_[static_cast<size_t>(l)]; }
   /// The link that connection @p j joins to link @p l.
   int otherLink(int j, int l) const;
 
@@ -139,6 +145,7 @@ struct SearchContext {
 
  private:
   core_detail::Buckets connections_;  // per link
+  std::vector<Eigen::Vector3d> twistOrigin_;  // per link
 };
 
 SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& model,
@@ -185,6 +192,15 @@ SearchContext::SearchContext(const Mechanism& mechanism, const CoordinateModel& 
   // Each row's norm once (a row is in up to 3 kMaxGroup groups).
   for (Eigen::Index r = 0; r < J.rows(); ++r)
     rowNorm[static_cast<size_t>(r)] = core_detail::rowNorm(J, r);
+  twistOrigin_.assign(static_cast<size_t>(numLinks), Eigen::Vector3d::Zero());
+  for (int l = 0; l < numLinks && static_cast<size_t>(l) < model.bodyElements.size(); ++l) {
+    for (int e : model.bodyElements[l]) {
+      if (model.elements[e].isPoint) {
+        twistOrigin_[static_cast<size_t>(l)] = element3(e);
+        break;
+      }
+    }
+  }
 }
 
 Eigen::Vector3d SearchContext::element3(int e) const {
@@ -192,18 +208,20 @@ Eigen::Vector3d SearchContext::element3(int e) const {
   return dim == 3 ? Eigen::Vector3d(q.segment<3>(o)) : Eigen::Vector3d(q(o), q(o + 1), 0.0);
 }
 
-TwistRow SearchContext::twistRow(int e, int k) const {
+TwistRow SearchContext::twistRow(int e, int k, const Eigen::Vector3d& about) const {
   const int o = model.elements[e].offset;
-  const double point = model.elements[e].isPoint ? 1.0 : 0.0;
+  const bool isPoint = model.elements[e].isPoint;
+  const double point = isPoint ? 1.0 : 0.0;
   TwistRow t = TwistRow::Zero();
   if (planar) {  // omega_z, v_x, v_y of x_k: (-y, 1, 0) and (x, 0, 1) for a point
     if (k == 0)
-      t.head<3>() << -q(o + 1), point, 0.0;
+      t.head<3>() << -(q(o + 1) - (isPoint ? about.y() : 0.0)), point, 0.0;
     else
-      t.head<3>() << q(o), 0.0, point;
+      t.head<3>() << q(o) - (isPoint ? about.x() : 0.0), 0.0, point;
     return t;
   }
-  const double x = q(o), y = q(o + 1), z = q(o + 2);
+  const Eigen::Vector3d shift = isPoint ? about : Eigen::Vector3d::Zero();
+  const double x = q(o) - shift.x(), y = q(o + 1) - shift.y(), z = q(o + 2) - shift.z();
   if (k == 0)
     t << 0.0, z, -y, point, 0.0, 0.0;
   else if (k == 1)
@@ -311,7 +329,7 @@ void EndConnectionBound::splitRow(Eigen::Index r, const ColumnOwners& owners, Ro
     }
     const int e = owner.element;
     const int k = static_cast<int>(it.col()) - context_.model.elements[e].offset;
-    parts.perLink[slot].second += (it.value() / norm) * context_.twistRow(e, k);
+    parts.perLink[slot].second += (it.value() / norm) * context_.twistRow(e, k, context_.twistOrigin(l));
   }
 }
 
@@ -367,9 +385,28 @@ bool EndConnectionBound::rigidByEnds(const std::vector<int>& path) const {
   return context_.planar ? rigidByEndsOf<3>(path) : rigidByEndsOf<6>(path);
 }
 
+/// S with t_from = S t_to for one motion written as the twist t_to about a point and as t_from about a point
+/// @p delta away from it: omega the same, v_from = v_to + omega x delta.
+template <int L>
+Eigen::Matrix<double, L, L> twistShift(const Eigen::Vector3d& delta) {
+  Eigen::Matrix<double, L, L> S = Eigen::Matrix<double, L, L>::Identity();
+  if constexpr (L == 3) {  // omega_z, v_x, v_y
+    S(1, 0) = -delta.y();
+    S(2, 0) = delta.x();
+  } else {
+    S.template block<3, 3>(3, 0) << 0.0, delta.z(), -delta.y(), -delta.z(), 0.0, delta.x(), delta.y(),
+        -delta.x(), 0.0;
+  }
+  return S;
+}
+
 template <int L>
 bool EndConnectionBound::rigidByEndsOf(const std::vector<int>& path) const {
   constexpr int lambda = L;
+  // Each link's sums are about its own twist origin; the group's are about its lowest link's, where the
+  // search takes its twists (GroupSearch): an end's Gram moves there exactly (S^T G S), and F_l at most by
+  // |S|_2^2 <= (1 + |delta|)^2, which can only make the bound more cautious.
+  const Eigen::Vector3d& about = context_.twistOrigin(*std::min_element(path.begin(), path.end()));
   Eigen::Matrix<double, L, L> gram = Eigen::Matrix<double, L, L>::Zero();
   double frobenius2 = 0.0;
   int ends = 0;
@@ -381,7 +418,9 @@ bool EndConnectionBound::rigidByEndsOf(const std::vector<int>& path) const {
     return false;
   };
   for (int l : path) {
-    frobenius2 += linkFrobenius_[static_cast<size_t>(l)];
+    const Eigen::Vector3d delta = context_.twistOrigin(l) - about;
+    const double stretch = 1.0 + delta.norm();
+    frobenius2 += linkFrobenius_[static_cast<size_t>(l)] * stretch * stretch;
     for (size_t s = 0; s < 2; ++s) {
       if (inPath(context_.otherLink(context_.connectionsAt(l)[s], l)))
         continue;
@@ -389,10 +428,17 @@ bool EndConnectionBound::rigidByEndsOf(const std::vector<int>& path) const {
       if (!endValid_[at])
         return false;
       ++ends;
-      const double* end = &endGram_[at * gramSize_];
+      const double* packed = &endGram_[at * gramSize_];
+      Eigen::Matrix<double, L, L> end;
       for (int r1 = 0; r1 < lambda; ++r1) {
         for (int c1 = 0; c1 <= r1; ++c1)
-          gram(r1, c1) += *end++;
+          end(r1, c1) = end(c1, r1) = *packed++;
+      }
+      if (delta.isZero(0.0)) {
+        gram += end;
+      } else {
+        const Eigen::Matrix<double, L, L> S = twistShift<L>(delta);
+        gram.noalias() += S.transpose() * end * S;
       }
     }
   }
@@ -514,6 +560,7 @@ class GroupSearch {
   // Work space of one group, reused (a chain of 10^5 links has 3 10^5 groups: no allocation per group).
   std::vector<int> group_, outside_, elements_, columns_, rows_;
   std::vector<TwistRow> twistRows_;  // the rows of T (lambda entries, zero beyond)
+  Eigen::Vector3d about_ = Eigen::Vector3d::Zero();  // the point the group's twists are about
 };
 
 GroupSearch::GroupSearch(const SearchContext& context)
@@ -579,10 +626,11 @@ void GroupSearch::collectColumnsAndRows() {
     elements_.insert(elements_.end(), model.bodyElements[l].begin(), model.bodyElements[l].end());
   columns_.clear();
   twistRows_.clear();
+  about_ = context_.twistOrigin(group_.front());  // group_ is sorted: its lowest link
   for (int e : elements_) {
     for (int k = 0; k < context_.dim; ++k) {
       columns_.push_back(model.elements[e].offset + k);
-      twistRows_.push_back(context_.twistRow(e, k));
+      twistRows_.push_back(context_.twistRow(e, k, about_));
     }
   }
   rows_.clear();
@@ -694,7 +742,9 @@ bool GroupSearch::movesFinitely(const Eigen::Vector3d& omega, const Eigen::Vecto
     moved_ = context_.q;
   for (int e : elements_) {
     const Eigen::Vector3d x = context_.element3(e);
-    const Eigen::Vector3d y = model.elements[e].isPoint ? (g * x).eval() : (g.linear() * x).eval();
+    // The twist is about about_: a point moves as about_ + g (x - about_).
+    const Eigen::Vector3d y =
+        model.elements[e].isPoint ? (about_ + g * (x - about_)).eval() : (g.linear() * x).eval();
     moved_.segment(model.elements[e].offset, dim) = y.head(dim);
   }
   // Only the rows touching the group can change.
