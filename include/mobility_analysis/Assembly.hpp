@@ -34,10 +34,13 @@ struct AssembledMechanism {
  * then built at the closed poses and checked.
  * @param[in] startPoses the written pose or the previous state; distance constraints take their lengths here.
  * @param[in] driven driven tree-joint values [rad] or [m]; empty: close from the start pose only.
+ * @param[in] sideThread whether a large model's joint values may be read off its poses on a second thread
+ *            while the model is built (the same values either way: AnalysisOptions::sideThreads).
  * @return The assembled mechanism, or a Diagnostic naming the loop element (residual and pose reached) or the
  *         driven joint that cannot reach its value.
  */
 Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const LinkPoses& startPoses,
-                                             AnalysisMode mode, const JointPositions& driven = {});
+                                             AnalysisMode mode, const JointPositions& driven = {},
+                                             bool sideThread = false);
 
 }  // namespace mobility_analysis

@@ -90,23 +90,38 @@ const char* toString(EquationKind kind);
 
 /// One scalar constraint equation, tagged with its source element.
 ///
-/// The members are ordered by size (the byte-sized tags first, the vectors last) so that no padding is
-/// left between them: a model has 10^6 of these, 96 bytes each instead of 112.
+/// 64 bytes: a model has 10^6 of these, and their first touch was a sixth of building a 10^5-link chain's
+/// model when they were 96. The byte-sized tags come first, then the operands; a Combination, which has no
+/// operands a, b, c of its own, keeps its basis directions and its two elements in them (d1(), d2(),
+/// target(), origin()), and a Coupling its index in c (coupling()). Read each through the accessor of the
+/// equation's form.
 struct ConstraintEquation {
   EquationSource source = EquationSource::Link;
   EquationKind kind = EquationKind::LinkDistance;
   EquationForm form = EquationForm::Dot;
-  int element = -1;  ///< Link index (Link, Boundary) or joint index (Joint).
-  int component = 0;
-  int target = -1;    ///< Combination: the element expressed.
-  int origin = -1;    ///< Combination: the body's base point (points only), else -1.
-  int coupling = -1;  ///< Coupling: index into CoordinateModel::couplings.
-  Direction a, b;     ///< Operands (Dot, Cross: a and b; Component: a; Triple: a, b and c).
-  Direction c;        ///< Triple: the third operand.
-  Direction d1, d2;   ///< Combination: the body's basis directions (planar: d2 unused).
+  unsigned char component = 0;  ///< Cross, Component, Combination: the coordinate (0, 1, 2).
+  int element = -1;             ///< Link index (Link, Boundary) or joint index (Joint).
+  Direction a, b;               ///< Operands (Dot, Cross: a and b; Component: a; Triple: a, b and c).
+  Direction c;                  ///< Triple: the third operand.
+  double value = 0.0;           ///< Dot, Cross, Component, Triple: the constant.
   Eigen::Vector3d coefficients = Eigen::Vector3d::Zero();  ///< Combination: c0, c1, c2.
-  double value = 0.0;                                      ///< Dot, Cross, Component: the constant.
+
+  /// Combination: the body's basis directions (planar: d2 unused).
+  Direction& d1() { return a; }
+  const Direction& d1() const { return a; }
+  Direction& d2() { return b; }
+  const Direction& d2() const { return b; }
+  /// Combination: the element expressed.
+  int& target() { return c.head; }
+  int target() const { return c.head; }
+  /// Combination: the body's base point (points only), else -1.
+  int& origin() { return c.tail; }
+  int origin() const { return c.tail; }
+  /// Coupling: index into CoordinateModel::couplings.
+  int& coupling() { return c.head; }
+  int coupling() const { return c.head; }
 };
+static_assert(sizeof(ConstraintEquation) == 64, "ConstraintEquation has padding or a member too many");
 
 /// The mechanism in natural coordinates: elements, their coordinates at the assembled pose and the equations.
 struct CoordinateModel {

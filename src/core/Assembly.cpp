@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
+#include "SideTask.hpp"
 #include "mobility_analysis/ConstraintJacobian.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/motion/DrivenAssembly.hpp"
@@ -12,6 +14,10 @@ namespace mobility_analysis {
 
 namespace {
 
+/// About the fewest equations a model has a link (a planar chain of pins: two); the side thread's threshold
+/// (SideTask.hpp, in equations) is counted against the links with it.
+constexpr size_t kEquationsPerLink = 2;
+
 double maxAbs(const Eigen::VectorXd& v) {
   return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff();
 }
@@ -19,11 +25,17 @@ double maxAbs(const Eigen::VectorXd& v) {
 }  // namespace
 
 Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const LinkPoses& startPoses,
-                                             AnalysisMode mode, const JointPositions& driven) {
+                                             AnalysisMode mode, const JointPositions& driven,
+                                             bool sideThread) {
   const double lc = computeCharacteristicLength(mechanism, startPoses);
   AssembledMechanism assembled;
   const ClosureLayout layout = makeClosureLayout(mechanism, startPoses, lc);
   const bool nothingToClose = layout.numResiduals == 0;
+  // Without driven joints their values are read off the closed poses (a fifth of the model's building on a
+  // 10^5-link chain), which nothing writes once the model is being built: on a large model, beside it.
+  const bool positionsBeside =
+      driven.empty() && sideThread &&
+      static_cast<long>(kEquationsPerLink * mechanism.links.size()) >= core_detail::kSecondThreadEquations;
   if (driven.empty()) {
     // closeLoops begins with the start's poses (reposeTree is posesOf(configurationFromPoses)) and their
     // residual, and stops there when the loops close already: with no residual rows (a tree with no
@@ -51,7 +63,8 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
       }
     }
     assembled.poses = std::move(poses);
-    assembled.positions = computeJointPositions(mechanism, assembled.poses);
+    if (!positionsBeside)
+      assembled.positions = computeJointPositions(mechanism, assembled.poses);
   } else {
     const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
     int numColumns = 0;
@@ -75,9 +88,14 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
     assembled.events = std::move(motion.events);
   }
 
+  std::optional<core_detail::SideTask<JointPositions>> positions;
+  if (positionsBeside)
+    positions.emplace(true, [&] { return computeJointPositions(mechanism, assembled.poses); });
   Result<CoordinateModel> model = buildCoordinateModel(mechanism, assembled.poses, mode, lc);
   if (!isOk(model))
     return diagnosticOf(model);
+  if (positions)
+    assembled.positions = positions->get();
   assembled.model = valueOf(std::move(model));
   // q0 is computeCoordinates at the poses the model was built at, value for value (the same products): a
   // copy, not a second pass over every element and its body's pose.

@@ -199,24 +199,24 @@ void addCouplingEquation(ModelBuilder& builder, int j) {
   eq.element = j;
   eq.kind = EquationKind::Coupling;
   eq.form = EquationForm::Coupling;
-  eq.coupling = static_cast<int>(model.couplings.size());
+  eq.coupling() = static_cast<int>(model.couplings.size());
   model.couplings.push_back(terms);
   model.equations.push_back(eq);
 }
 
 double CouplingForm::value(const ElementView& v, const ConstraintEquation& eq) {
-  return evaluateCoupling(v.model().couplings[eq.coupling], v.model(), v.q());
+  return evaluateCoupling(v.model().couplings[eq.coupling()], v.model(), v.q());
 }
 
 void CouplingForm::gradient(const ElementView& v, const ConstraintEquation& eq, int row, GradientSink& sink) {
-  appendCouplingGradient(v.model().couplings[eq.coupling], v.model(), v.q(), row, sink);
+  appendCouplingGradient(v.model().couplings[eq.coupling()], v.model(), v.q(), row, sink);
 }
 
 void CouplingForm::hessian(const ElementView& v, const ConstraintEquation& eq, double weight,
                            HessianSink& sink) {
   std::vector<int> columns;
   Eigen::MatrixXd hessian;
-  computeCouplingHessian(v.model().couplings[eq.coupling], v.model(), v.q(), columns, hessian);
+  computeCouplingHessian(v.model().couplings[eq.coupling()], v.model(), v.q(), columns, hessian);
   for (size_t a = 0; a < columns.size(); ++a) {
     for (size_t b = 0; b < columns.size(); ++b) {
       if (hessian(a, b) != 0.0)

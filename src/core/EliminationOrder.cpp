@@ -55,7 +55,7 @@ SweepGraph::SweepGraph(const Mechanism& mechanism, const CoordinateModel& model)
     groupOfRow[static_cast<size_t>(r)] = group;
     rowsOf.count(group);
     if (eq.form == EquationForm::Combination)
-      expressed[eq.target] = 1;
+      expressed[eq.target()] = 1;
   }
   rowsOf.allocate();
   for (int r = 0; r < numRows; ++r)

@@ -61,8 +61,8 @@ class EquationPlaces {
           located_[r] = 1;
         }
       } else if (eq.source == EquationSource::Link && eq.form == EquationForm::Combination &&
-                 model.elements[eq.target].isPoint) {
-        place_[r] = position(eq.target);
+                 model.elements[eq.target()].isPoint) {
+        place_[r] = position(eq.target());
         located_[r] = 1;
       } else {
         attached_[eq.element].push_back(r);

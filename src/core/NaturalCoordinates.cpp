@@ -351,12 +351,12 @@ std::string describeEquation(const CoordinateModel& model, int row) {
     case EquationKind::Distance:
       return "|" + label(eq.a.head) + " - " + label(eq.a.tail) + "|^2 = " + number(eq.value) + " Lc^2";
     case EquationKind::LinearCombination: {
-      std::string text = label(eq.target) + " = ";
-      if (eq.origin >= 0)
-        text += label(eq.origin) + " + ";
-      text += number(eq.coefficients.x()) + " " + name(eq.d1) + " + " + number(eq.coefficients.y()) +
-              (planar ? " J" + name(eq.d1)
-                      : " " + name(eq.d2) + " + " + number(eq.coefficients.z()) + " d1 x d2");
+      std::string text = label(eq.target()) + " = ";
+      if (eq.origin() >= 0)
+        text += label(eq.origin()) + " + ";
+      text += number(eq.coefficients.x()) + " " + name(eq.d1()) + " + " + number(eq.coefficients.y()) +
+              (planar ? " J" + name(eq.d1())
+                      : " " + name(eq.d2()) + " + " + number(eq.coefficients.z()) + " d1 x d2");
       return text + axis;
     }
     case EquationKind::CoincidentPoint:
@@ -365,7 +365,7 @@ std::string describeEquation(const CoordinateModel& model, int row) {
       return label(eq.a.head) + "_" + kAxisNames[eq.component] + " = " + number(eq.value) +
              (model.elements[eq.a.head].isPoint ? " Lc" : "");
     case EquationKind::Coupling: {
-      const CouplingTerms& terms = model.couplings[eq.coupling];
+      const CouplingTerms& terms = model.couplings[eq.coupling()];
       auto value = [&](const JointValueOperand& o) {
         return o.prismatic ? "s(" + label(o.aHead) + " -> " + label(o.bHead) + ")"
                            : "angle(" + label(o.aHead) + ", " + label(o.bHead) + ")";

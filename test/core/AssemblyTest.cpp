@@ -161,3 +161,24 @@ TEST(Assembly, JointPositionsAreReadBackByNameWhateverTheirLength) {
     }
   }
 }
+
+// A large model may read its joint values off the poses on a second thread while its model is built: the
+// same assembly, bit for bit (a chain above the side thread's threshold, at a pose with nonzero joints).
+TEST(Assembly, SideThreadGivesTheSameAssembly) {
+  const int links = 12000;
+  const Result<Mechanism> loaded = loadMechanismFromString(straightChainUrdf(links), "long_chain.urdf");
+  ASSERT_TRUE(isOk(loaded)) << diagnosticOf(loaded).toString();
+  const Mechanism& mechanism = valueOf(loaded);
+  JointPositions bent;
+  for (int i = 1; i <= links; i += 7)
+    bent["j" + std::to_string(i)] = 0.001 * (i % 13);
+  const LinkPoses start = computeTreePoses(mechanism, bent);
+  const Result<AssembledMechanism> alone = assembleMechanism(mechanism, start, AnalysisMode::Auto, {}, false);
+  const Result<AssembledMechanism> beside = assembleMechanism(mechanism, start, AnalysisMode::Auto, {}, true);
+  ASSERT_TRUE(isOk(alone)) << diagnosticOf(alone).toString();
+  ASSERT_TRUE(isOk(beside)) << diagnosticOf(beside).toString();
+  EXPECT_EQ(valueOf(alone).positions, valueOf(beside).positions);
+  EXPECT_EQ(valueOf(alone).positions.size(), static_cast<size_t>(links));
+  EXPECT_TRUE(valueOf(alone).q == valueOf(beside).q);
+  EXPECT_EQ(valueOf(alone).model.numConstraints(), valueOf(beside).model.numConstraints());
+}

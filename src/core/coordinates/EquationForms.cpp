@@ -14,8 +14,8 @@ Eigen::Matrix3d crossMatrix(const Eigen::Vector3d& v) {
 /// The planar operand J d1 (a quarter turn) of a Combination, or d2 in space.
 Eigen::Vector3d secondBasis(const ElementView& v, const ConstraintEquation& eq) {
   if (v.dim() == 3)
-    return v.direction(eq.d2);
-  const Eigen::Vector3d d1 = v.direction(eq.d1);
+    return v.direction(eq.d2());
+  const Eigen::Vector3d d1 = v.direction(eq.d1());
   return Eigen::Vector3d(-d1.y(), d1.x(), 0.0);
 }
 
@@ -123,11 +123,11 @@ void ComponentForm::hessian(const ElementView&, const ConstraintEquation&, doubl
 // --- Combination: (x_target - x_origin - c0 d1 - c1 d2 - c2 d1 x d2)_k
 // ----------------------------------------
 double CombinationForm::value(const ElementView& v, const ConstraintEquation& eq) {
-  const Eigen::Vector3d d1 = v.direction(eq.d1);
+  const Eigen::Vector3d d1 = v.direction(eq.d1());
   const Eigen::Vector3d d2 = secondBasis(v, eq);
-  Eigen::Vector3d r = v.element(eq.target) - eq.coefficients.x() * d1 - eq.coefficients.y() * d2;
-  if (eq.origin >= 0)
-    r -= v.element(eq.origin);
+  Eigen::Vector3d r = v.element(eq.target()) - eq.coefficients.x() * d1 - eq.coefficients.y() * d2;
+  if (eq.origin() >= 0)
+    r -= v.element(eq.origin());
   if (v.dim() == 3)
     r -= eq.coefficients.z() * d1.cross(d2);
   return r[eq.component];
@@ -139,19 +139,19 @@ void CombinationForm::gradient(const ElementView& v, const ConstraintEquation& e
   const Eigen::Vector3d ek = Eigen::Vector3d::Unit(k);
   const Eigen::Vector3d& c = eq.coefficients;
   const FormWriter writer(v);
-  writer.addElement(eq.target, ek, row, sink);
-  if (eq.origin >= 0)
-    writer.addElement(eq.origin, -ek, row, sink);
+  writer.addElement(eq.target(), ek, row, sink);
+  if (eq.origin() >= 0)
+    writer.addElement(eq.origin(), -ek, row, sink);
   if (v.dim() == 3) {
     // -(c0 d1 + c1 d2 + c2 d1 x d2)_k: d/dd1 = -c0 e_k - c2 (d2 x e_k), d/dd2 = -c1 e_k - c2 (e_k x d1).
-    const Eigen::Vector3d d1 = v.direction(eq.d1);
-    const Eigen::Vector3d d2 = v.direction(eq.d2);
-    writer.addDirection(eq.d1, -c.x() * ek - c.z() * d2.cross(ek), row, sink);
-    writer.addDirection(eq.d2, -c.y() * ek - c.z() * ek.cross(d1), row, sink);
+    const Eigen::Vector3d d1 = v.direction(eq.d1());
+    const Eigen::Vector3d d2 = v.direction(eq.d2());
+    writer.addDirection(eq.d1(), -c.x() * ek - c.z() * d2.cross(ek), row, sink);
+    writer.addDirection(eq.d2(), -c.y() * ek - c.z() * ek.cross(d1), row, sink);
   } else {
     // -(c0 d1 + c1 J d1)_k with J d1 = (-d1_y, d1_x): row k of c0 I + c1 J.
     const Eigen::Vector3d jRow = k == 0 ? Eigen::Vector3d(0.0, -1.0, 0.0) : Eigen::Vector3d(1.0, 0.0, 0.0);
-    writer.addDirection(eq.d1, -c.x() * ek - c.y() * jRow, row, sink);
+    writer.addDirection(eq.d1(), -c.x() * ek - c.y() * jRow, row, sink);
   }
 }
 
@@ -161,7 +161,7 @@ void CombinationForm::hessian(const ElementView& v, const ConstraintEquation& eq
   if (v.dim() != 3 || eq.coefficients.z() == 0.0)
     return;
   FormWriter(v).addBilinear(
-      eq.d1, eq.d2, eq.coefficients.z() * crossMatrix(Eigen::Vector3d::Unit(eq.component)), weight, sink);
+      eq.d1(), eq.d2(), eq.coefficients.z() * crossMatrix(Eigen::Vector3d::Unit(eq.component)), weight, sink);
 }
 
 // --- Triple: (a x b).c - value

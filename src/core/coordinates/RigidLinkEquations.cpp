@@ -73,10 +73,10 @@ void addRigidLinkEquations(ModelBuilder& builder) {
         eq.kind = EquationKind::LinearCombination;
         eq.form = EquationForm::Combination;
         eq.component = k;
-        eq.target = e;
-        eq.origin = isPoint ? basis.p0 : -1;
-        eq.d1 = basis.d1;
-        eq.d2 = basis.d2;
+        eq.target() = e;
+        eq.origin() = isPoint ? basis.p0 : -1;
+        eq.d1() = basis.d1;
+        eq.d2() = basis.d2;
         eq.coefficients = coefficients;
         if (planar)
           eq.coefficients.z() = 0.0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "mobility_analysis/Tolerances.hpp"
@@ -69,6 +70,19 @@ double typicalLength(const Mechanism& mechanism) {
 }
 
 std::optional<Diagnostic> checkLengthRange(const Mechanism& mechanism) {
+  // The median of the nonzero lengths is one of them, so at least the shortest: a model whose longest length
+  // is within range of its shortest is within range of its median, found without the list of lengths and
+  // its selection (on a 10^5-joint chain 2.4 MB of fresh pages and a partial sort of 2 10^5 values).
+  double shortest = std::numeric_limits<double>::infinity(), longestOfAll = 0.0;
+  forEachLength(mechanism, [&](double value, int, const char*) {
+    if (value > tolerances::kZeroVector && std::isfinite(value))  // the median's lengths (medianOfNonzero)
+      shortest = std::min(shortest, value);
+    longestOfAll = std::max(longestOfAll, value);
+    return false;
+  });
+  if (shortest == std::numeric_limits<double>::infinity() ||
+      longestOfAll <= tolerances::kMaxRelativeLength * shortest)
+    return std::nullopt;  // no nonzero length (no typical length), or all within range of the shortest
   double longest = 0.0;
   const double typical = medianOfNonzero(mechanism, &longest);
   if (typical <= 0.0)

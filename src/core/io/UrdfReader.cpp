@@ -344,13 +344,15 @@ class Reader {
     return index;
   }
 
-  /// The index of link @p name, or -1. Links are mostly referred to in the order they are written (a joint's
-  /// parent is the last one's child, its child the next link): the link found last and the one after it are
-  /// compared first, in cache, before a probe of the index (a hash and two cache misses on 10^5 links).
+  /// The index of link @p name, or -1. Links are mostly referred to in the order they are written: written
+  /// root first, a joint's parent is the last one's child and its child the next link (+1, 0); written leaf
+  /// first, its parent is the link after the last one's parent (+2 from the last one's child) and its child
+  /// the link before that (-1). Those neighbours are compared first, in cache, before a probe of the index (a
+  /// hash and two cache misses on 10^5 links).
   int findLink(const char* name) const {
     const std::vector<Link>& links = mechanism_.links;
     const std::string_view key(name);  // its length once; a guess of another length costs one comparison
-    for (const int guess : {lastLink_ + 1, lastLink_}) {
+    for (const int guess : {lastLink_ + 1, lastLink_, lastLink_ + 2, lastLink_ - 1}) {
       if (guess >= 0 && guess < static_cast<int>(links.size()) &&
           links[static_cast<size_t>(guess)].name == key)
         return lastLink_ = guess;
