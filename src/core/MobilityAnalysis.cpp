@@ -95,7 +95,7 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   // the written pose), so the mechanism stays in the start's assembly mode (motion/DrivenAssembly.hpp).
   Result<AssembledMechanism> assembled =
       assembleMechanism(mechanism, options.startPoses ? *options.startPoses : computeTreePoses(mechanism, {}),
-                        options.mode, options.positions);
+                        options.mode, options.positions, options.sideThreads);
   if (!isOk(assembled))
     return diagnosticOf(assembled);
   MobilityAnalysis analysis;
