@@ -27,6 +27,11 @@ constexpr double kClosure = 1e-9;
 /// cannot reach it from its pose and from any restart cannot be closed.
 constexpr double kAssemblyTarget = 1e-12;
 
+/// A closure residual computed from coordinates far from the model's origin is rounded to about this many
+/// eps times their largest magnitude: where that exceeds a target (a mechanism 10^4 Lc off its URDF's
+/// origin), the target is that instead [-].
+constexpr double kCoordinateRounding = 16.0;
+
 /// Levenberg–Marquardt iterations of one closure attempt (from the pose or from one restart).
 constexpr int kClosureMaxIterations = 200;
 

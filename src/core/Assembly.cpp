@@ -50,7 +50,7 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
       Eigen::VectorXd residual;
       evaluateClosure(mechanism, layout, poses, columns, numColumns, residual, nullptr);
       assembled.initialResidual = maxAbs(residual) * lc;
-      closed = maxAbs(residual) <= tolerances::kAssemblyTarget;
+      closed = maxAbs(residual) <= layout.target;
       if (!closed) {
         Result<ClosedConfiguration> reached = closeLoops(
             mechanism, layout, configurationFromPoses(mechanism, layout, startPoses), columns, numColumns);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "TextFile.hpp"
 #include "core/TestModels.hpp"
 
 using namespace mobility_analysis;
@@ -181,4 +182,35 @@ TEST(Assembly, SideThreadGivesTheSameAssembly) {
   EXPECT_EQ(valueOf(alone).positions.size(), static_cast<size_t>(links));
   EXPECT_TRUE(valueOf(alone).q == valueOf(beside).q);
   EXPECT_EQ(valueOf(alone).model.numConstraints(), valueOf(beside).model.numConstraints());
+}
+
+TEST(Assembly, aMechanismFarFromTheOriginOfItsModelClosesAndReportsAsNearIt) {
+  // Welded 10^3 to 10^5 m off the origin and turned (a new root link): the loops close (their residual can
+  // be no smaller than the rounding of poses that far out, ClosureLayout::target) and the report's counts
+  // and idle motions are those of the mechanism at the origin. Before, from 10^4 m every loop was refused
+  // ("cannot be closed: residual 1.6e-12 m").
+  for (const char* file : {"delta_robot.urdf", "stewart_6sps.urdf", "bennett.urdf"}) {
+    const MobilityReport near = analyzeOrFail(urdfPath(file), AnalysisMode::Spatial).report;
+    for (const char* offset : {"1000 -1000 1000", "10000 10000 -10000", "100000 100000 100000"}) {
+      SCOPED_TRACE(std::string(file) + " at " + offset);
+      const Result<Mechanism> moved =
+          loadMechanismFromString(placedAt(readTextFile(urdfPath(file)), offset), file);
+      ASSERT_TRUE(isOk(moved)) << diagnosticOf(moved).toString();
+      AnalysisOptions options;
+      options.mode = AnalysisMode::Spatial;
+      const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(moved), options);
+      ASSERT_TRUE(isOk(analysis)) << diagnosticOf(analysis).toString();
+      const MobilityReport& far = valueOf(analysis).report;
+      EXPECT_EQ(far.dof, near.dof);
+      EXPECT_EQ(far.finiteDof, near.finiteDof);
+      EXPECT_EQ(far.passiveDof, near.passiveDof);
+      EXPECT_EQ(far.numRedundant, near.numRedundant);
+      EXPECT_EQ(far.grublerKutzbachDof, near.grublerKutzbachDof);
+      EXPECT_EQ(far.singular, near.singular);
+      ASSERT_EQ(far.passiveMotions.size(), near.passiveMotions.size());
+      for (size_t k = 0; k < near.passiveMotions.size(); ++k)
+        EXPECT_EQ(far.passiveMotions[k].description, near.passiveMotions[k].description);
+      EXPECT_LE(far.closureResidualAfter, 1e-9 * far.characteristicLength);
+    }
+  }
 }

@@ -257,22 +257,6 @@ TEST(PassiveFreedoms, endConnectionBoundSettlesEveryGroupOfASerialChain) {
   }
 }
 
-namespace {
-
-/// @p urdf with its root link welded, at @p offset (and turned), to a new root: the same mechanism far from
-/// the origin of the model.
-std::string placedAt(const std::string& urdf, const std::string& offset) {
-  const size_t root = urdf.find("<link name=\"");
-  const size_t nameStart = root + 12;
-  const std::string name = urdf.substr(nameStart, urdf.find('"', nameStart) - nameStart);
-  return urdf.substr(0, root) +
-         "<link name=\"far_world\"/><joint name=\"far\" type=\"fixed\"><parent link=\"" +
-         "far_world\"/><child link=\"" + name + "\"/><origin xyz=\"" + offset +
-         "\" rpy=\"0.3 0.2 0.1\"/></joint>\n" + urdf.substr(root);
-}
-
-}  // namespace
-
 TEST(PassiveFreedoms, aMechanismFarFromTheOriginHasTheSameIdleMotionsAndBound) {
   // A group's twists are taken about a point of the group, not the origin of the model: far from it a twist
   // about the origin mixed lengths of 10^5 with lengths of 1, the end-connection bound could not settle a

@@ -58,6 +58,18 @@ inline ModelAtTreePose assembleAtTreePose(Mechanism mechanism, AnalysisMode mode
   return model;
 }
 
+/// @p urdf with its root link welded, at @p offset ("x y z" [m]) and turned, to a new root: the same
+/// mechanism far from the origin of the model.
+inline std::string placedAt(const std::string& urdf, const std::string& offset) {
+  const size_t root = urdf.find("<link name=\"");
+  const size_t nameStart = root + 12;
+  const std::string name = urdf.substr(nameStart, urdf.find('"', nameStart) - nameStart);
+  return urdf.substr(0, root) +
+         "<link name=\"far_world\"/><joint name=\"far\" type=\"fixed\"><parent link=\"" +
+         "far_world\"/><child link=\"" + name + "\"/><origin xyz=\"" + offset +
+         "\" rpy=\"0.3 0.2 0.1\"/></joint>\n" + urdf.substr(root);
+}
+
 /// A straight chain of @p links revolute joints about z, 0.1 m apart: DOF @p links in the plane and in space.
 inline std::string straightChainUrdf(int links) {
   std::string text = "<robot name='chain'><link name='l0'/>";

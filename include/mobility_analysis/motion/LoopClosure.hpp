@@ -21,7 +21,7 @@ bool solveDampedLeastSquares(const Eigen::SparseMatrix<double>& J, const Eigen::
 struct ClosureSolve {
   int iterations = 0;
   double residual = 0.0;   ///< max |residual| at the end [Lc or rad].
-  bool converged = false;  ///< residual <= tolerances::kAssemblyTarget.
+  bool converged = false;  ///< residual <= the layout's target (ClosureLayout::target).
   LinkPoses poses;         ///< The end point's poses (posesOf the configuration).
 };
 

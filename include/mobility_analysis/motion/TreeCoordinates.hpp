@@ -8,6 +8,7 @@
 
 #include "mobility_analysis/Kinematics.hpp"
 #include "mobility_analysis/Mechanism.hpp"
+#include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
 
@@ -46,6 +47,9 @@ struct ClosureLayout {
   std::vector<double> length;       ///< Per connection: distance or taut cable length [Lc] (else 0).
   int numUnknowns = 0;
   int numResiduals = 0;
+  /// The largest residual taken as closed [Lc or rad]: tolerances::kAssemblyTarget, or the rounding of the
+  /// poses where the mechanism lies so far from the model's origin that it is larger (makeClosureLayout).
+  double target = tolerances::kAssemblyTarget;
 };
 
 /**

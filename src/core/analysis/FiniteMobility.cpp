@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 
+#include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/coordinates/EquationForms.hpp"
 
 namespace mobility_analysis {
@@ -16,6 +18,8 @@ namespace {
 
 /// Step along a first-order motion before projecting back [normalised length].
 constexpr double kStep = 1e-4;
+/// The largest residual a projected step may keep [normalised] (near the model's origin).
+constexpr double kProjected = 1e-13;
 /// A quadratic form Q_ω whose entries are below this fraction of its scale (Σ |ω_i| |H_i| |x|^2) vanishes
 /// [-].
 constexpr double kSecondOrder = 1e-6;
@@ -166,9 +170,14 @@ FiniteMobility analyzeFiniteMobility(const CoordinateModel& model, const Eigen::
       canStep ? Eigen::MatrixXd(Eigen::HouseholderQR<Eigen::MatrixXd>(N).householderQ() *
                                 Eigen::MatrixXd::Identity(n, d))
               : Eigen::MatrixXd();
+  // Projected to 1e-13, or to the rounding of the coordinates where they are far larger than 1 (a mechanism
+  // 10^3 Lc off its model's origin never projected below 1e-13, and its every direction read as no motion).
+  const double largest = canStep && q.size() > 0 ? q.cwiseAbs().maxCoeff() : 0.0;
+  const double closure = std::max(
+      kProjected, tolerances::kCoordinateRounding * std::numeric_limits<double>::epsilon() * largest);
   auto step = [&](const Eigen::VectorXd& direction) {
     const Eigen::VectorXd stepped = q + kStep * direction.normalized();
-    return std::make_pair(stepped, projectOntoConstraints(model, stepped, 1e-13, 60));
+    return std::make_pair(stepped, projectOntoConstraints(model, stepped, closure, 60));
   };
 
   bool extends = true;

@@ -61,7 +61,7 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
   // Closed already (the usual case for a written or previous pose): no Jacobian, whose rows walk the tree
   // paths of every loop (long on deep trees such as a mast written as one chain).
   evaluateClosure(mechanism, layout, poses, columns, numColumns, r, nullptr);
-  if (maxAbs(r) <= tolerances::kAssemblyTarget) {
+  if (maxAbs(r) <= layout.target) {
     result.residual = maxAbs(r);
     result.converged = true;
     result.poses = std::move(poses);
@@ -71,10 +71,10 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
   double cost = r.squaredNorm();
   double mu = -1.0, nu = 2.0;
   // Below the target, a few more steps take the residual down to round-off; then stop.
-  const double floor = tolerances::kAssemblyTarget * 1e-2;
+  const double floor = layout.target * 1e-2;
   int belowTargetSteps = 0;
   while (result.iterations < maxIterations && maxAbs(r) > floor && numColumns > 0) {
-    if (maxAbs(r) <= tolerances::kAssemblyTarget && ++belowTargetSteps > 3)
+    if (maxAbs(r) <= layout.target && ++belowTargetSteps > 3)
       break;
     if (mu < 0.0) {
       double largest = 0.0;
@@ -121,7 +121,7 @@ ClosureSolve solveClosure(const Mechanism& mechanism, const ClosureLayout& layou
     }
   }
   result.residual = maxAbs(r);
-  result.converged = result.residual <= tolerances::kAssemblyTarget;
+  result.converged = result.residual <= layout.target;
   result.poses = std::move(poses);  // r is the residual at these poses: each accepted step set both
   return result;
 }
