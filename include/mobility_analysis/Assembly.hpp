@@ -29,7 +29,8 @@ struct AssembledMechanism {
  * The closure works in tree coordinates (motion/LoopClosure.hpp): the tree joints hold by construction, the
  * loop-closing connections are residuals written as differences of frames (so a revolute or weld cannot close
  * on an axis turned by 180°), and a Levenberg–Marquardt solver with restarts brings them to
- * tolerances::kAssemblyTarget (normalised). With @p driven values, followDrivenPositions
+ * tolerances::kAssemblyTarget (normalised; far from the model's origin, the rounding of its coordinates:
+ * ClosureLayout::target). With @p driven values, followDrivenPositions
  * (motion/DrivenAssembly.hpp) moves the mechanism there on the start's assembly mode. The analysis model is
  * then built at the closed poses and checked.
  * @param[in] startPoses the written pose or the previous state; distance constraints take their lengths here.
