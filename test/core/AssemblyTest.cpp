@@ -196,11 +196,7 @@ TEST(Assembly, aMechanismFarFromTheOriginOfItsModelClosesAndReportsAsNearIt) {
       const Result<Mechanism> moved =
           loadMechanismFromString(placedAt(readTextFile(urdfPath(file)), offset), file);
       ASSERT_TRUE(isOk(moved)) << diagnosticOf(moved).toString();
-      AnalysisOptions options;
-      options.mode = AnalysisMode::Spatial;
-      const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(moved), options);
-      ASSERT_TRUE(isOk(analysis)) << diagnosticOf(analysis).toString();
-      const MobilityReport& far = valueOf(analysis).report;
+      const MobilityReport far = analyzeOrFail(valueOf(moved), AnalysisMode::Spatial).report;
       EXPECT_EQ(far.dof, near.dof);
       EXPECT_EQ(far.finiteDof, near.finiteDof);
       EXPECT_EQ(far.passiveDof, near.passiveDof);

@@ -26,9 +26,8 @@ inline Mechanism loadOrFail(const std::string& path) {
   return valueOf(std::move(mechanism));
 }
 
-/// Analyses a file in @p mode; fails the test with the diagnostic when it cannot.
-inline MobilityAnalysis analyzeOrFail(const std::string& path, AnalysisMode mode) {
-  const Mechanism mechanism = loadOrFail(path);
+/// Analyses @p mechanism in @p mode; fails the test with the diagnostic when it cannot.
+inline MobilityAnalysis analyzeOrFail(const Mechanism& mechanism, AnalysisMode mode) {
   AnalysisOptions options;
   options.mode = mode;
   Result<MobilityAnalysis> analysis = analyzeMechanism(mechanism, options);
@@ -37,6 +36,11 @@ inline MobilityAnalysis analyzeOrFail(const std::string& path, AnalysisMode mode
     return MobilityAnalysis{};
   }
   return valueOf(std::move(analysis));
+}
+
+/// Analyses a file in @p mode; fails the test with the diagnostic when it cannot.
+inline MobilityAnalysis analyzeOrFail(const std::string& path, AnalysisMode mode) {
+  return analyzeOrFail(loadOrFail(path), mode);
 }
 
 /// A mechanism assembled from its written (tree) pose, with the constraint Jacobian there.
