@@ -148,11 +148,6 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
       analyzeFiniteMobility(model, analysis.assembled.q, J, basis, ranks, tolerance);
   report.finiteDof = finite.finiteDof;
   report.singular = finite.singular;
-  progress("passive freedoms", 0.87);
-  const PassiveFreedoms passive = passiveTask.get();
-  report.passiveDof = std::min(passive.dof, report.finiteDof);
-  report.passiveMotions = passive.motions;
-  report.outputDof = report.finiteDof - report.passiveDof;
   report.nullityTrace = ranks.nullityTrace;
   report.characteristicLength = model.characteristicLength;
   report.closureResidualBefore = analysis.assembled.initialResidual;
@@ -284,6 +279,13 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
                      joint.length, distance});
     }
   }
+  // The passive-freedom search is taken last: on a chain it takes longer than the sweep it runs beside, and
+  // the redundant equations, loops and the report's records need nothing from it.
+  progress("passive freedoms", 0.93);
+  const PassiveFreedoms passive = passiveTask.get();
+  report.passiveDof = std::min(passive.dof, report.finiteDof);
+  report.passiveMotions = passive.motions;
+  report.outputDof = report.finiteDof - report.passiveDof;
   progress("self-stress report", 0.95);
   report.selfStress = stressReportTask.get();
   progress("done", 1.0);
