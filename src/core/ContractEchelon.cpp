@@ -156,13 +156,8 @@ class Patches {
     // tree joint's equations pivot on the child's coordinates and leave the parent's free for its other
     // children (measured on the braced lattice: 40% less fill than the other way round).
     std::sort(columns.begin(), columns.end(), std::greater<int>());
-    for (size_t c = 0; c < columns.size(); ++c)
-      columnMap_[columns[c]] = static_cast<int>(c);
     SparseJacobian& local = local_;
-    core_detail::copyRows(
-        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local);
-    for (int c : columns)
-      columnMap_[c] = -1;
+    core_detail::copyRowsOver(J_, rows, columns, columnMap_, local);
 
     // The same patch elsewhere (a regular structure) has the same dependencies to the bit (LocalMemo): the
     // elimination reads the local matrix and nothing else. What a patch wants is fixed before it is

@@ -67,5 +67,18 @@ void copyRows(const SparseJacobian& J, const std::vector<int>& rows, LocalOf&& l
   outer[rows.size()] = written;
 }
 
+/// copyRows over @p columns, numbered 0, 1, ... in the order given. @p map (one entry per column of @p J, all
+/// -1) holds their numbers while the rows are copied and is all -1 again afterwards.
+inline void copyRowsOver(const SparseJacobian& J, const std::vector<int>& rows,
+                         const std::vector<int>& columns, std::vector<int>& map, SparseJacobian& local) {
+  for (size_t c = 0; c < columns.size(); ++c)
+    map[static_cast<size_t>(columns[c])] = static_cast<int>(c);
+  copyRows(
+      J, rows, [&](int column) { return map[static_cast<size_t>(column)]; }, static_cast<int>(columns.size()),
+      local);
+  for (int c : columns)
+    map[static_cast<size_t>(c)] = -1;
+}
+
 }  // namespace core_detail
 }  // namespace mobility_analysis

@@ -284,13 +284,8 @@ class LocalStressFinder {
       std::sort(columns.begin(), columns.end(),
                 [&](int a, int b) { return order_.columnPriority[a] < order_.columnPriority[b]; });
     }
-    for (size_t c = 0; c < columns.size(); ++c)
-      columnMap_[columns[c]] = static_cast<int>(c);
     SparseJacobian& local = local_;
-    core_detail::copyRows(
-        J_, rows, [&](int column) { return columnMap_[column]; }, static_cast<int>(columns.size()), local);
-    for (int c : columns)
-      columnMap_[c] = -1;
+    core_detail::copyRowsOver(J_, rows, columns, columnMap_, local);
 
     // The same local problem elsewhere (a regular structure) has the same dependency to the bit
     // (LocalMemo): the elimination reads the local matrix and nothing else.
