@@ -269,6 +269,10 @@ class JsonParts {
   /// Appends the text from @p from to @p to; with @p stream, writes it there, @p text holding a chunk at a
   /// time.
   void write(std::string& text, Cut from, Cut to, std::ostream* stream = nullptr) const;
+  /// write from begin() to end(), the second half (from middle()) on another thread once the estimate
+  /// reaches @p secondThreadFrom bytes: into its own string, then appended (the copy costs a fiftieth of the
+  /// writing) or written to @p stream.
+  void writeAll(std::string& text, size_t secondThreadFrom, std::ostream* stream) const;
 
  private:
   struct Part {
@@ -320,43 +324,15 @@ std::string core_detail::toJson(const MobilityReport& r, size_t secondThreadFrom
   const size_t size = parts.estimatedBytes();
   std::string text;
   text.reserve(size + size / 16);  // a margin: a doubling at the very end would copy all of it once more
-  if (size < secondThreadFrom) {
-    parts.write(text, parts.begin(), parts.end());
-    return text;
-  }
-  // The second half on another thread, into its own string, then appended: the copy costs a fiftieth of the
-  // writing.
-  const JsonParts::Cut middle = parts.middle();
-  core_detail::SideTask secondHalf(true, [&] {
-    std::string half;
-    half.reserve(size / 2 + size / 16);
-    parts.write(half, middle, parts.end());
-    return half;
-  });
-  parts.write(text, parts.begin(), middle);
-  text += secondHalf.get();
+  parts.writeAll(text, secondThreadFrom, nullptr);
   return text;
 }
 
 void core_detail::writeJson(const MobilityReport& r, std::ostream& out, size_t secondThreadFrom) {
   // As toJson, but the text goes to the stream as it is written instead of into one string: the first half
   // never exists whole, and the second (when on another thread) only until it is written.
-  const JsonParts parts(r);
   std::string chunk;
-  if (parts.estimatedBytes() < secondThreadFrom) {
-    parts.write(chunk, parts.begin(), parts.end(), &out);
-    return;
-  }
-  const JsonParts::Cut middle = parts.middle();
-  core_detail::SideTask secondHalf(true, [&] {
-    std::string half;
-    half.reserve(parts.estimatedBytes() / 2 + parts.estimatedBytes() / 16);
-    parts.write(half, middle, parts.end());
-    return half;
-  });
-  parts.write(chunk, parts.begin(), middle, &out);
-  const std::string half = secondHalf.get();
-  out.write(half.data(), static_cast<std::streamsize>(half.size()));
+  JsonParts(r).writeAll(chunk, secondThreadFrom, &out);
 }
 
 namespace {
@@ -686,6 +662,26 @@ void JsonParts::write(std::string& text, Cut from, Cut to, std::ostream* stream)
     const bool last = p == to.part;                       // ends within the list: its close is after
     writePart(out, part, p == from.part ? from.item : 0, last ? to.item : part.items, !inside, !last);
   }
+}
+
+void JsonParts::writeAll(std::string& text, size_t secondThreadFrom, std::ostream* stream) const {
+  if (total_ < secondThreadFrom) {
+    write(text, begin(), end(), stream);
+    return;
+  }
+  const Cut cut = middle();
+  core_detail::SideTask secondHalf(true, [&] {
+    std::string half;
+    half.reserve(total_ / 2 + total_ / 16);
+    write(half, cut, end());
+    return half;
+  });
+  write(text, begin(), cut, stream);
+  const std::string half = secondHalf.get();
+  if (stream != nullptr)
+    stream->write(half.data(), static_cast<std::streamsize>(half.size()));
+  else
+    text += half;
 }
 
 void JsonParts::writePart(BufferedAppender& out, const Part& part, size_t from, size_t to, bool open,
