@@ -1,5 +1,8 @@
 #pragma once
 
+#include <algorithm>
+#include <limits>
+
 namespace mobility_analysis {
 
 /**
@@ -31,6 +34,12 @@ constexpr double kAssemblyTarget = 1e-12;
 /// eps times their largest magnitude: where that exceeds a target (a mechanism 10^4 Lc off its URDF's
 /// origin), the target is that instead [-].
 constexpr double kCoordinateRounding = 16.0;
+
+/// @p target, or the rounding of coordinates of largest magnitude @p magnitude (kCoordinateRounding eps
+/// times it) where that is larger: the smallest residual such coordinates can reach [same unit as both].
+inline double reachableTarget(double target, double magnitude) {
+  return std::max(target, kCoordinateRounding * std::numeric_limits<double>::epsilon() * magnitude);
+}
 
 /// Levenberg–Marquardt iterations of one closure attempt (from the pose or from one restart).
 constexpr int kClosureMaxIterations = 200;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <random>
 
@@ -173,8 +172,7 @@ FiniteMobility analyzeFiniteMobility(const CoordinateModel& model, const Eigen::
   // Projected to 1e-13, or to the rounding of the coordinates where they are far larger than 1 (a mechanism
   // 10^3 Lc off its model's origin never projected below 1e-13, and its every direction read as no motion).
   const double largest = canStep && q.size() > 0 ? q.cwiseAbs().maxCoeff() : 0.0;
-  const double closure = std::max(
-      kProjected, tolerances::kCoordinateRounding * std::numeric_limits<double>::epsilon() * largest);
+  const double closure = tolerances::reachableTarget(kProjected, largest);
   auto step = [&](const Eigen::VectorXd& direction) {
     const Eigen::VectorXd stepped = q + kStep * direction.normalized();
     return std::make_pair(stepped, projectOntoConstraints(model, stepped, closure, 60));

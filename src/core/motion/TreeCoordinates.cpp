@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "mobility_analysis/Tolerances.hpp"
 
@@ -292,14 +291,11 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
   // A residual is a difference of two frames reached through the tree, each rounded to about eps times its
   // distance from the origin: a mechanism 10^4 Lc from it (a robot welded 10 km off its URDF's origin) cannot
   // close below a few 1e-12 Lc, and kAssemblyTarget (1e-12) would refuse every loop of it. The target is
-  // kAssemblyTarget up to about 300 Lc from the origin (every bundled model), then kCoordinateRounding eps
-  // per Lc.
+  // kAssemblyTarget up to about 300 Lc from the origin (every bundled model), then the coordinates' rounding.
   double extent = 0.0;
   for (const Eigen::Isometry3d& pose : written)
     extent = std::max(extent, pose.translation().cwiseAbs().maxCoeff());
-  layout.target = std::max(
-      tolerances::kAssemblyTarget,
-      tolerances::kCoordinateRounding * std::numeric_limits<double>::epsilon() * extent / lengthScale);
+  layout.target = tolerances::reachableTarget(tolerances::kAssemblyTarget, extent / lengthScale);
   return layout;
 }
 
