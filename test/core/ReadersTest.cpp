@@ -436,12 +436,14 @@ TEST(Warnings, EveryClassFiresAndNamesItsElement) {
   // The closure file and MJCF.
   const std::string yaml = writeTemp("w.yaml",
                                      "closed_loop: [['closure_A', 'closure_B']]\ntype: ['6d']\n"
-                                     "joint_type: ['UJOINT_XY']\nsolver: fast\n");
+                                     "joint_name: ['free_B', 'no_such_joint']\n"
+                                     "joint_type: ['UJOINT_XX', 'SPHERICAL']\nsolver: fast\n");
   ReadOptions options;
   options.closuresFile = yaml;
   const std::vector<std::string> wy = warningTexts(readOrFail(formatPath("five_bar_gepetto.urdf"), options));
   EXPECT_TRUE(anyContains(wy, "w.yaml: yaml 'solver'", "unknown key"));
-  EXPECT_TRUE(anyContains(wy, "closed_loop 'closed_loop_0'", "joint_type 'UJOINT_XY' is not read"));
+  EXPECT_TRUE(anyContains(wy, "joint_type 'free_B'", "'UJOINT_XX' is none of"));
+  EXPECT_TRUE(anyContains(wy, "joint_name 'no_such_joint'", "not a tree joint"));
   const std::string mjcf = writeTemp("w.xml", R"(<mujoco model="w"><worldbody>
   <body name="a"><joint name="ja" type="hinge"/><geom size="0.1"/></body>
   <body name="b" pos="1 0 0"><joint name="jb" type="hinge"/><geom size="0.1"/></body></worldbody>
@@ -691,16 +693,15 @@ TEST(Readers, MjcfWeldHoldsTwoBodiesTogether) {
   EXPECT_EQ(spatial.numRedundant, 4);
 }
 
-TEST(Readers, ClosureFileNamesTypesAndFramesOfJoints) {
-  // A frame may be a tree joint (its child link's frame); joint_type SPHERICAL makes a 6d pair a ball.
-  const std::string yaml = ::testing::TempDir() + "named.yaml";
-  std::ofstream(yaml) << "closed_loop: [['to_closure_A', 'free_B']]\ntype: ['6d']\njoint_name: ['C']\n"
-                         "joint_type: ['SPHERICAL']\n";
+TEST(Readers, ClosureFileFramesOfJointsAndLoopNames) {
+  // A frame may be a tree joint (its child link's frame); the closures are named closed_loop_<i>.
+  const std::string yaml =
+      writeTemp("framed.yaml", "closed_loop: [['to_closure_A', 'free_B']]\ntype: ['3d']\n");
   ReadOptions options;
   options.closuresFile = yaml;
   const Mechanism m = readOrFail(formatPath("five_bar_gepetto.urdf"), options);
   EXPECT_TRUE(m.warnings.empty());
-  const Joint& c = m.joints[*m.findJoint("C")];
+  const Joint& c = m.joints[*m.findJoint("closed_loop_0")];
   EXPECT_EQ(c.kind, ConnectionKind::LoopJoint);
   EXPECT_EQ(c.type, JointType::Spherical);
   EXPECT_EQ(m.links[c.link1].name, "closure_A");
@@ -713,6 +714,95 @@ TEST(Readers, ClosureFileNamesTypesAndFramesOfJoints) {
   const Result<Mechanism> bad = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
   ASSERT_FALSE(isOk(bad));
   EXPECT_NE(diagnosticOf(bad).what.find("1 types for 2 closed_loop pairs"), std::string::npos);
+}
+
+/// The five-bar of five_bar_gepetto.urdf welded at C (6d), with the closure file's extra lines @p rebuild.
+MobilityReport weldedFiveBarWith(const std::string& rebuild, std::vector<std::string>* warnings = nullptr) {
+  ReadOptions options;
+  options.closuresFile =
+      writeTemp("rebuilt.yaml", "closed_loop: [['closure_A', 'closure_B']]\ntype: ['6d']\n" + rebuild);
+  const Mechanism m = readOrFail(formatPath("five_bar_gepetto.urdf"), options);
+  if (warnings != nullptr)
+    *warnings = warningTexts(m);
+  return reportOf(m, AnalysisMode::Auto);
+}
+
+TEST(Readers, ClosureFileRebuildsTreeJointsAsGepettosLoaderDoes) {
+  // Gepetto's joint_name / joint_type turn tree joints of the URDF into other joints. Here the pin free_B
+  // that carries closure_B on distal_right; closure_B is welded to closure_A on distal_left. Links 7,
+  // revolutes 4 (5 equations each in space), to_closure_A fixed (6), the weld (6). As written: the planar
+  // five-bar, 3*6 - 2*4 - 3 - 3 = 2.
+  const MobilityReport pin = weldedFiveBarWith("");
+  EXPECT_EQ(pin.mode, "planar");
+  EXPECT_EQ(pin.dof, 2);
+  // SPHERICAL: a ball at C. The five-bar moves as before (2) and the ball's rotation is set by the weld;
+  // 36 - 20 - 6 - 3 - 6 = 1, so the ball's out-of-plane equation is redundant.
+  const MobilityReport ball = weldedFiveBarWith("joint_name: ['free_B']\njoint_type: ['SPHERICAL']\n");
+  EXPECT_EQ(ball.mode, "spatial");
+  EXPECT_EQ(ball.dof, 2);
+  EXPECT_EQ(ball.grublerKutzbachDof, 1);
+  EXPECT_EQ(ball.numRedundant, 1);
+  // UJOINT_ZX: a universal joint turning about z on distal_right, then x on closure_B: the five-bar still
+  // turns about z at C (2), and x cannot turn, as both sides only turn about z; 36 - 20 - 6 - 4 - 6 = 0.
+  const MobilityReport ujointZx = weldedFiveBarWith("joint_name: ['free_B']\njoint_type: ['UJOINT_ZX']\n");
+  EXPECT_EQ(ujointZx.dof, 2);
+  EXPECT_EQ(ujointZx.grublerKutzbachDof, 0);
+  EXPECT_EQ(ujointZx.numRedundant, 2);
+  // Pinocchio's R_Z then R_X at the joint's place: z turns on the parent's side, x on the child's.
+  ReadOptions options;
+  options.closuresFile = writeTemp("zx.yaml",
+                                   "closed_loop: [['closure_A', 'closure_B']]\ntype: ['6d']\n"
+                                   "joint_name: ['free_B']\njoint_type: ['UJOINT_ZX']\n");
+  const Mechanism zx = readOrFail(formatPath("five_bar_gepetto.urdf"), options);
+  const Joint& universal = zx.joints[*zx.findJoint("free_B")];
+  EXPECT_EQ(universal.type, JointType::Universal);
+  EXPECT_EQ(universal.axis, Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(universal.axis2, Eigen::Vector3d::UnitX());
+  EXPECT_EQ(zx.links[universal.link1].name, "distal_right");
+  // UJOINT_XY: neither axis is z, so C holds the two distal links' angle: a four-bar (1), Gruebler 0.
+  const MobilityReport ujointXy = weldedFiveBarWith("joint_name: ['free_B']\njoint_type: ['UJOINT_XY']\n");
+  EXPECT_EQ(ujointXy.dof, 1);
+  EXPECT_EQ(ujointXy.grublerKutzbachDof, 0);
+  EXPECT_EQ(ujointXy.numRedundant, 1);
+  // FIXED: frozen at zero, C is rigid: the four-bar again, in the plane 3*6 - 2*4 - 3*3 = 1.
+  const MobilityReport frozen = weldedFiveBarWith("joint_name: ['free_B']\njoint_type: ['FIXED']\n");
+  EXPECT_EQ(frozen.mode, "planar");
+  EXPECT_EQ(frozen.dof, 1);
+  EXPECT_EQ(frozen.grublerKutzbachDof, 1);
+  // An older file's rotule_name: every tree joint whose name contains it becomes a ball (free_B alone here).
+  const MobilityReport rotule = weldedFiveBarWith("rotule_name: free_\n");
+  EXPECT_EQ(rotule.dof, ball.dof);
+  EXPECT_EQ(rotule.grublerKutzbachDof, ball.grublerKutzbachDof);
+  EXPECT_EQ(rotule.numRedundant, ball.numRedundant);
+  // A name that is no tree joint (a typo, which Gepetto's loader passes over) and a type it does not build
+  // are warnings; the joints stay as the URDF writes them.
+  std::vector<std::string> warnings;
+  const MobilityReport unread = weldedFiveBarWith(
+      "joint_name: ['free_b', 'elbow_left']\njoint_type: ['SPHERICAL', 'PLANAR']\n", &warnings);
+  EXPECT_EQ(unread.dof, 2);
+  EXPECT_EQ(unread.mode, "planar");
+  EXPECT_TRUE(anyContains(warnings, "joint_name 'free_b'", "not a tree joint"));
+  EXPECT_TRUE(anyContains(warnings, "joint_type 'elbow_left'", "'PLANAR'"));
+}
+
+TEST(Readers, ClosureFileRebuildErrorsAreOneLine) {
+  ReadOptions options;
+  // One type per name.
+  options.closuresFile = writeTemp("short.yaml",
+                                   "closed_loop: [['closure_A', 'closure_B']]\ntype: ['6d']\n"
+                                   "joint_name: ['free_B', 'elbow_left']\njoint_type: ['SPHERICAL']\n");
+  const Result<Mechanism> shorter = readMechanism(formatPath("five_bar_gepetto.urdf"), options);
+  ASSERT_FALSE(isOk(shorter));
+  EXPECT_NE(diagnosticOf(shorter).toString().find("1 joint types for 2 joint names"), std::string::npos);
+  // A joint a <mimic> couples keeps one value: it cannot become a ball.
+  options.closuresFile = writeTemp(
+      "coupled.yaml", "closed_loop: []\ntype: []\njoint_name: ['right']\njoint_type: ['SPHERICAL']\n");
+  const Result<Mechanism> coupled = readMechanism(formatPath("gripper_mimic.urdf"), options);
+  ASSERT_FALSE(isOk(coupled));
+  const std::string line = diagnosticOf(coupled).toString();
+  EXPECT_NE(line.find("joint_name 'right'"), std::string::npos) << line;
+  EXPECT_NE(line.find("coupled"), std::string::npos) << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos);
 }
 
 // --- SDFormat
