@@ -37,6 +37,9 @@ struct JointValueOperand {
 struct CouplingTerms {
   JointValueOperand follower;
   JointValueOperand leader;
+  /// Joint values added to the follower's and to the leader's (Joint::moreFollowers, Joint::moreLeaders:
+  /// revolute ones only, so in the same unit).
+  std::vector<JointValueOperand> moreFollowers, moreLeaders;
   double multiplier = 1.0;  ///< m, in follower units per leader unit (normalised lengths for prismatic).
   double offset = 0.0;      ///< c, in follower units.
 };
@@ -45,7 +48,7 @@ struct CouplingTerms {
 double evaluateJointValue(const JointValueOperand& operand, const CoordinateModel& model,
                           const Eigen::Ref<const Eigen::VectorXd>& q);
 
-/// @return The residual \f$ v_f - m v_l - c \f$ at @p q.
+/// @return The residual \f$ v_f - m v_l - c \f$ at @p q (each v with the values summed with it).
 double evaluateCoupling(const CouplingTerms& terms, const CoordinateModel& model,
                         const Eigen::Ref<const Eigen::VectorXd>& q);
 

@@ -62,6 +62,11 @@ struct Joint {
   int follower = -1;
   double multiplier = 1.0;
   double offset = 0.0;
+  /// Coupling only: further 1-DOF tree joints whose values add to the leader's and to the follower's
+  /// (generalized_rbda's coupling of two links sums the joint values on each link's path from their nearest
+  /// common ancestor): value(follower) + sum moreFollowers = multiplier (value(leader) + sum moreLeaders) +
+  /// offset. Usually empty.
+  std::vector<int> moreLeaders, moreFollowers;
 };
 
 /// Joint values by tree-joint name [rad] or [m].

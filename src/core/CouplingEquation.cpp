@@ -69,6 +69,10 @@ std::map<int, Eigen::Vector3d> gradientByElement(const CouplingTerms& terms, con
   std::map<int, Eigen::Vector3d> byElement;
   jointValueGradient(terms.follower, model, q, 1.0, byElement);
   jointValueGradient(terms.leader, model, q, -terms.multiplier, byElement);
+  for (const JointValueOperand& o : terms.moreFollowers)
+    jointValueGradient(o, model, q, 1.0, byElement);
+  for (const JointValueOperand& o : terms.moreLeaders)
+    jointValueGradient(o, model, q, -terms.multiplier, byElement);
   return byElement;
 }
 
@@ -87,8 +91,13 @@ double evaluateJointValue(const JointValueOperand& o, const CoordinateModel& mod
 
 double evaluateCoupling(const CouplingTerms& terms, const CoordinateModel& model,
                         const Eigen::Ref<const Eigen::VectorXd>& q) {
-  return evaluateJointValue(terms.follower, model, q) -
-         terms.multiplier * evaluateJointValue(terms.leader, model, q) - terms.offset;
+  double follower = evaluateJointValue(terms.follower, model, q);
+  double leader = evaluateJointValue(terms.leader, model, q);
+  for (const JointValueOperand& o : terms.moreFollowers)
+    follower += evaluateJointValue(o, model, q);
+  for (const JointValueOperand& o : terms.moreLeaders)
+    leader += evaluateJointValue(o, model, q);
+  return follower - terms.multiplier * leader - terms.offset;
 }
 
 void appendCouplingGradient(const CouplingTerms& terms, const CoordinateModel& model,
@@ -188,6 +197,10 @@ void addCouplingEquation(ModelBuilder& builder, int j) {
   CouplingTerms terms;
   terms.follower = makeOperand(coupling.follower);
   terms.leader = makeOperand(coupling.leader);
+  for (const int t : coupling.moreFollowers)
+    terms.moreFollowers.push_back(makeOperand(t));
+  for (const int t : coupling.moreLeaders)
+    terms.moreLeaders.push_back(makeOperand(t));
   // v_f [SI] = m v_l [SI] + c, with prismatic values in normalised lengths: scale by Lc.
   const double lc = model.characteristicLength;
   const double followerScale = terms.follower.prismatic ? lc : 1.0;

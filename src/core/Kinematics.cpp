@@ -152,8 +152,12 @@ double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, 
       const auto it = values.find(mechanism.joints[j].name);
       return it == values.end() ? 0.0 : it->second;
     };
-    const double residual =
-        std::abs(value(joint.follower) - joint.multiplier * value(joint.leader) - joint.offset);
+    double follower = value(joint.follower), leader = value(joint.leader);
+    for (const int j : joint.moreFollowers)
+      follower += value(j);
+    for (const int j : joint.moreLeaders)
+      leader += value(j);
+    const double residual = std::abs(follower - joint.multiplier * leader - joint.offset);
     return mechanism.joints[joint.follower].type == JointType::Prismatic ? residual : lengthScale * residual;
   }
   if (joint.kind == ConnectionKind::DistanceConstraint || joint.kind == ConnectionKind::Cable ||

@@ -370,8 +370,15 @@ std::string describeEquation(const CoordinateModel& model, int row) {
         return o.prismatic ? "s(" + label(o.aHead) + " -> " + label(o.bHead) + ")"
                            : "angle(" + label(o.aHead) + ", " + label(o.bHead) + ")";
       };
-      return value(terms.follower) + " = " + number(terms.multiplier) + " " + value(terms.leader) + " + " +
-             number(terms.offset) + (terms.follower.prismatic ? " Lc" : " rad");
+      auto sum = [&](const JointValueOperand& first, const std::vector<JointValueOperand>& more) {
+        std::string text = value(first);
+        for (const JointValueOperand& o : more)
+          text += " + " + value(o);
+        return more.empty() ? text : "(" + text + ")";
+      };
+      return sum(terms.follower, terms.moreFollowers) + " = " + number(terms.multiplier) + " " +
+             sum(terms.leader, terms.moreLeaders) + " + " + number(terms.offset) +
+             (terms.follower.prismatic ? " Lc" : " rad");
     }
     default:
       break;

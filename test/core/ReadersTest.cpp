@@ -283,6 +283,85 @@ TEST(Couplings, HoldTheFollowerAtMultiplierTimesTheLeaderPlusOffset) {
   }
 }
 
+/// A planar leg as generalized_rbda writes its transmissions: hip and knee in series, a rotor on the base,
+/// and a URDF+ coupling between the links @p predecessor and @p successor (ratio 2).
+std::string legWithRotor(const std::string& predecessor, const std::string& successor) {
+  return "<robot name='leg'><link name='base'/><link name='thigh'/><link name='shank'/><link name='rotor'/>"
+         "<joint name='hip' type='revolute'><parent link='base'/><child link='thigh'/><axis xyz='0 0 1'/>"
+         "<limit lower='-3' upper='3' effort='1' velocity='1'/></joint>"
+         "<joint name='knee' type='revolute'><parent link='thigh'/><child link='shank'/><origin xyz='0.3 0 "
+         "0'/>"
+         "<axis xyz='0 0 1'/><limit lower='-3' upper='3' effort='1' velocity='1'/></joint>"
+         "<joint name='spin' type='continuous'><parent link='base'/><child link='rotor'/><origin xyz='0 0.1 "
+         "0'/>"
+         "<axis xyz='0 0 1'/></joint>"
+         "<coupling name='belt' type='rolling'><predecessor link='" +
+         predecessor + "'/><successor link='" + successor + "'/><ratio value='2'/></coupling></robot>";
+}
+
+TEST(Couplings, BetweenLinksSumTheJointValuesFromTheirCommonAncestor) {
+  // generalized_rbda's coupling of two links: ratio times the joint values summed from the links' nearest
+  // common ancestor to the predecessor equals that sum to the successor. shank -> rotor: spin = 2 (hip +
+  // knee), a belt over the knee (the MIT humanoid's ankle); thigh -> rotor: spin = 2 hip, one joint each
+  // side.
+  for (const auto& [predecessor, expected] :
+       {std::pair<std::string, double>{"shank", 2.0 * (0.3 + 0.2)}, {"thigh", 2.0 * 0.3}}) {
+    SCOPED_TRACE(predecessor);
+    const Result<Mechanism> m = readMechanismFromString(legWithRotor(predecessor, "rotor"), "leg.urdf");
+    ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+    const Joint& belt = valueOf(m).joints[*valueOf(m).findJoint("belt")];
+    EXPECT_EQ(belt.kind, ConnectionKind::Coupling);
+    EXPECT_EQ(belt.moreLeaders.size(), predecessor == "shank" ? 1u : 0u);
+    // Three joints and one coupling: DOF 2 in the plane (3*4 - 2*3 - 3 - 1 = 2), the rotor held at 2 x the
+    // sum.
+    const MobilityReport r = reportOf(valueOf(m), AnalysisMode::Auto, {{"hip", 0.3}, {"knee", 0.2}});
+    EXPECT_EQ(r.mode, "planar");
+    EXPECT_EQ(r.dof, 2);
+    EXPECT_EQ(r.grublerKutzbachDof, 2);
+    EXPECT_EQ(r.numRedundant, 0);
+    double spin = 0.0;
+    for (const JointValue& v : r.positions)
+      spin = v.name == "spin" ? v.value : spin;
+    EXPECT_NEAR(spin, expected, 1e-9);
+    // The natural-coordinate equation reads the same sum: spin - 2 (hip + knee) at a pose set by hand.
+    for (const double written : {expected, expected - 0.4}) {
+      const LinkPoses poses = computeTreePoses(valueOf(m), {{"hip", 0.3}, {"knee", 0.2}, {"spin", written}});
+      const Result<CoordinateModel> built = buildCoordinateModel(
+          valueOf(m), poses, AnalysisMode::Planar, computeCharacteristicLength(valueOf(m), poses));
+      ASSERT_TRUE(isOk(built)) << diagnosticOf(built).toString();
+      Eigen::VectorXd phi;
+      computeConstraintResidual(valueOf(built), computeCoordinates(valueOf(built), poses), phi);
+      const int row = valueOf(built).numConstraints() - valueOf(built).lambda - 1;
+      ASSERT_EQ(valueOf(built).equations[row].kind, EquationKind::Coupling);
+      EXPECT_NEAR(phi(row), written - expected, 1e-12);
+    }
+  }
+  // One joint each side is the joint coupling <predecessor joint='hip'/><successor joint='spin'/>.
+  std::string byJoint = legWithRotor("thigh", "rotor");
+  byJoint.replace(byJoint.find("link='thigh'/><successor"), std::string("link='thigh'").size(),
+                  "joint='hip'");
+  byJoint.replace(byJoint.find("link='rotor'/><ratio"), std::string("link='rotor'").size(), "joint='spin'");
+  const Result<Mechanism> twin = readMechanismFromString(byJoint, "twin.urdf");
+  ASSERT_TRUE(isOk(twin)) << diagnosticOf(twin).toString();
+  const MobilityReport t = reportOf(valueOf(twin), AnalysisMode::Auto, {{"hip", 0.3}, {"knee", 0.2}});
+  EXPECT_EQ(t.dof, 2);
+  for (const JointValue& v : t.positions) {
+    if (v.name == "spin")
+      EXPECT_NEAR(v.value, 0.6, 1e-9);
+  }
+  // A link that is the other's ancestor has no joint on its side, and a prismatic joint cannot join a sum of
+  // angles: one line each, never a dropped constraint.
+  const Result<Mechanism> ancestor = readMechanismFromString(legWithRotor("thigh", "shank"), "leg.urdf");
+  ASSERT_FALSE(isOk(ancestor));
+  EXPECT_NE(diagnosticOf(ancestor).toString().find("is an ancestor of"), std::string::npos);
+  std::string sliding = legWithRotor("shank", "rotor");
+  sliding.replace(sliding.find("'knee' type='revolute'"), std::string("'knee' type='revolute'").size(),
+                  "'knee' type='prismatic'");
+  const Result<Mechanism> mixed = readMechanismFromString(sliding, "leg.urdf");
+  ASSERT_FALSE(isOk(mixed));
+  EXPECT_NE(diagnosticOf(mixed).toString().find("not revolute"), std::string::npos);
+}
+
 TEST(Couplings, HoldWhenEitherJointIsDriven) {
   // b = -a + 0.1: drive the leader and the follower follows, drive the follower and the leader does.
   const Mechanism gripper = readOrFail(formatPath("gripper_revolute_mimic.urdf"));

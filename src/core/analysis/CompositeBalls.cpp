@@ -39,9 +39,12 @@ std::vector<LinkConnections> connectionsOfLinks(const Mechanism& mechanism) {
     const Joint& joint = mechanism.joints[j];
     if (joint.kind == ConnectionKind::Coupling) {
       // A coupled revolute is driven by another joint: not a free ball.
-      for (int coupled : {joint.leader, joint.follower}) {
-        if (coupled >= 0) {
-          const Joint& c = mechanism.joints[static_cast<size_t>(coupled)];
+      std::vector<int> coupled = {joint.leader, joint.follower};
+      coupled.insert(coupled.end(), joint.moreLeaders.begin(), joint.moreLeaders.end());
+      coupled.insert(coupled.end(), joint.moreFollowers.begin(), joint.moreFollowers.end());
+      for (const int t : coupled) {
+        if (t >= 0) {
+          const Joint& c = mechanism.joints[static_cast<size_t>(t)];
           add(c.link1, -1);
           add(c.link2, -1);
         }
@@ -185,6 +188,10 @@ MechanismWithBalls mergeCompositeBalls(const Mechanism& mechanism, const LinkPos
       continue;
     joint.leader = joint.leader >= 0 ? newJoint[static_cast<size_t>(joint.leader)] : -1;
     joint.follower = joint.follower >= 0 ? newJoint[static_cast<size_t>(joint.follower)] : -1;
+    for (std::vector<int>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
+      for (int& t : *more)
+        t = newJoint[static_cast<size_t>(t)];
+    }
   }
   return merged;
 }

@@ -67,8 +67,12 @@ std::optional<Diagnostic> retypeJoint(Mechanism& mechanism, const std::string& n
     return std::nullopt;
   }
   for (const Joint& coupling : mechanism.joints) {
+    const auto inSum = [&](const std::vector<int>& more) {
+      return std::find(more.begin(), more.end(), *found) != more.end();
+    };
     if (coupling.kind == ConnectionKind::Coupling &&
-        (coupling.leader == *found || coupling.follower == *found))
+        (coupling.leader == *found || coupling.follower == *found || inSum(coupling.moreLeaders) ||
+         inSum(coupling.moreFollowers)))
       return makeDiagnostic(
           file, "joint_name", name,
           "is coupled to another joint by '" + coupling.name + "'; it cannot become " + type);

@@ -177,6 +177,8 @@ struct PendingCoupling {
   std::string name;
   std::string kind;  ///< "joint" (a mimic) or "coupling", for diagnostics.
   std::string leader, follower;
+  /// generalized_rbda names the two links instead (`<predecessor link=...>`): their parent joints then.
+  bool byLink = false;
   double multiplier = 1.0;
   double offset = 0.0;
 };
@@ -625,7 +627,9 @@ class Reader {
     coupling.name = elementName(e, "coupling");
     checkChildren(e, "coupling", coupling.name,
                   {"predecessor", "successor", "leader", "follower", "ratio", "offset"});
-    auto jointOf = [&](const char* first, const char* second) -> std::string {
+    // generalized_rbda writes <predecessor link=.../>: its couplings hold ratio times the predecessor's joint
+    // values from the two links' nearest common ancestor to the successor's (explicitRollingConstraint).
+    auto endOf = [&](const char* first, const char* second) -> std::string {
       Element c = e.child(first);
       if (!c)
         c = e.child(second);
@@ -633,12 +637,18 @@ class Reader {
         fail("coupling", coupling.name,
              std::string("missing <") + first + " joint=\"...\"> (or <" + second + ">)");
       const char* joint = attributeOf(c, "joint");
+      const char* link = attributeOf(c, "link");
+      if (joint == nullptr && link == nullptr)
+        fail("coupling", coupling.name, std::string("<") + c.name() + "> has no joint or link attribute");
       if (joint == nullptr)
-        fail("coupling", coupling.name, std::string("<") + c.name() + "> has no joint attribute");
-      return joint;
+        coupling.byLink = true;
+      return joint != nullptr ? joint : link;
     };
-    coupling.leader = jointOf("predecessor", "leader");
-    coupling.follower = jointOf("successor", "follower");
+    coupling.leader = endOf("predecessor", "leader");
+    const bool leaderByLink = coupling.byLink;
+    coupling.follower = endOf("successor", "follower");
+    if (leaderByLink != coupling.byLink)
+      fail("coupling", coupling.name, "names a joint at one end and a link at the other");
     Element ratio = e.child("ratio");
     if (!ratio)
       fail("coupling", coupling.name, "missing <ratio value=\"...\">");
@@ -646,6 +656,66 @@ class Reader {
     if (Element offset = e.child("offset"))
       coupling.offset = number(attributeOf(offset, "value"), "coupling", coupling.name, "offset value");
     couplings_.push_back(std::move(coupling));
+  }
+
+  /// The tree joints from link @p linkName up to the root, nearest first (@p role names it in errors).
+  std::vector<int> pathToRoot(const std::string& linkName, const PendingCoupling& pending,
+                              const char* role) const {
+    if (parentJoint_.empty()) {  // built once, at the first coupling between links
+      parentJoint_.assign(mechanism_.links.size(), -1);
+      for (size_t j = 0; j < mechanism_.joints.size(); ++j) {
+        if (mechanism_.joints[j].kind == ConnectionKind::TreeJoint)
+          parentJoint_[static_cast<size_t>(mechanism_.joints[j].link2)] = static_cast<int>(j);
+      }
+    }
+    std::vector<int> path;
+    for (int joint =
+             parentJoint_[static_cast<size_t>(link(linkName.c_str(), "coupling", pending.name, role))];
+         joint >= 0; joint = parentJoint_[static_cast<size_t>(mechanism_.joints[joint].link1)])
+      path.push_back(joint);
+    return path;
+  }
+
+  /**
+   * A coupling between two links (generalized_rbda): ratio times the sum of the joint values on the
+   * predecessor's path from the two links' nearest common ancestor equals that sum on the successor's path
+   * (its explicitRollingConstraint); its benchmarks and the MIT humanoid's ankle have two joints on one path.
+   * The first joint of each path is the leader or follower, the rest go to moreLeaders / moreFollowers; every
+   * joint on a longer path must be revolute or continuous, as the sum then has one unit.
+   */
+  void coupleLinks(const PendingCoupling& pending, Joint& coupling) const {
+    std::vector<int> leaders = pathToRoot(pending.leader, pending, "predecessor link");
+    std::vector<int> followers = pathToRoot(pending.follower, pending, "successor link");
+    // Drop the common part above the nearest common ancestor (both paths end at the root).
+    while (!leaders.empty() && !followers.empty() && leaders.back() == followers.back()) {
+      leaders.pop_back();
+      followers.pop_back();
+    }
+    if (leaders.empty() || followers.empty()) {
+      fail("coupling", pending.name,
+           "link '" + (leaders.empty() ? pending.leader : pending.follower) + "' is an ancestor of '" +
+               (leaders.empty() ? pending.follower : pending.leader) + "': no joint to couple on its side");
+    }
+    if (leaders.size() + followers.size() > 2) {
+      for (const int j : leaders.size() > 1 ? leaders : followers) {
+        const JointType type = mechanism_.joints[static_cast<size_t>(j)].type;
+        if (type != JointType::Revolute && type != JointType::Continuous)
+          fail("coupling", pending.name,
+               "sums the values of joint '" + mechanism_.joints[static_cast<size_t>(j)].name +
+                   "', which is not revolute; only revolute joint values are summed");
+      }
+      for (const int j : leaders.size() > 1 ? followers : leaders) {
+        const JointType type = mechanism_.joints[static_cast<size_t>(j)].type;
+        if (type != JointType::Revolute && type != JointType::Continuous)
+          fail("coupling", pending.name,
+               "couples joint '" + mechanism_.joints[static_cast<size_t>(j)].name +
+                   "' to a sum of revolute joint values; it is not revolute");
+      }
+    }
+    coupling.leader = leaders.front();
+    coupling.follower = followers.front();
+    coupling.moreLeaders.assign(leaders.begin() + 1, leaders.end());
+    coupling.moreFollowers.assign(followers.begin() + 1, followers.end());
   }
 
   void addCoupling(const PendingCoupling& pending) {
@@ -665,8 +735,18 @@ class Reader {
     joint.name = pending.name;
     claimName("coupling", joint.name);
     joint.kind = ConnectionKind::Coupling;
-    joint.leader = resolve(pending.leader, pending.kind == "joint" ? "mimic joint" : "predecessor");
-    joint.follower = resolve(pending.follower, "successor");
+    if (pending.byLink) {
+      coupleLinks(pending, joint);
+      for (const int j : {joint.leader, joint.follower})
+        resolve(mechanism_.joints[static_cast<size_t>(j)].name, "joint");
+      for (const std::vector<int>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
+        for (const int j : *more)
+          resolve(mechanism_.joints[static_cast<size_t>(j)].name, "joint");
+      }
+    } else {
+      joint.leader = resolve(pending.leader, pending.kind == "joint" ? "mimic joint" : "predecessor");
+      joint.follower = resolve(pending.follower, "successor");
+    }
     if (joint.leader == joint.follower)
       fail(pending.kind, element, "couples joint '" + pending.leader + "' to itself");
     joint.type = mechanism_.joints[joint.follower].type;
@@ -683,6 +763,7 @@ class Reader {
   io_detail::NameIndex connectionIndex_;  ///< Connection index (into mechanism_.joints) by name.
   std::vector<int> parentOf_;
   std::vector<PendingCoupling> couplings_;
+  mutable std::vector<int> parentJoint_;  ///< Tree joint whose child each link is (-1: the root); lazily.
   mutable int lastLink_ = -1;  ///< The link findLink found last (a guess for the next; changes no result).
 };
 

@@ -62,9 +62,14 @@ void addCouplingRow(const Mechanism& mechanism, const ClosureLayout& layout, con
   const Joint& leader = mechanism.joints[coupling.leader];
   const double followerScale = follower.type == JointType::Prismatic ? lc : 1.0;
   const double leaderScale = leader.type == JointType::Prismatic ? lc : 1.0;
+  // The joints summed with either end are revolute (the reader checks it), in the ends' unit.
+  double followerValue = unknownValue(follower, poses, lc), leaderValue = unknownValue(leader, poses, lc);
+  for (const int j : coupling.moreFollowers)
+    followerValue += unknownValue(mechanism.joints[j], poses, lc);
+  for (const int j : coupling.moreLeaders)
+    leaderValue += unknownValue(mechanism.joints[j], poses, lc);
   double r =
-      unknownValue(follower, poses, lc) -
-      (coupling.multiplier * unknownValue(leader, poses, lc) * leaderScale + coupling.offset) / followerScale;
+      followerValue - (coupling.multiplier * leaderValue * leaderScale + coupling.offset) / followerScale;
   if (follower.type != JointType::Prismatic)
     r = std::remainder(r, 2.0 * M_PI);
   residual(row) = r;
@@ -76,6 +81,14 @@ void addCouplingRow(const Mechanism& mechanism, const ClosureLayout& layout, con
     triplets->emplace_back(row, fc, 1.0);
   if (lcol >= 0)
     triplets->emplace_back(row, lcol, -coupling.multiplier * leaderScale / followerScale);
+  for (const int j : coupling.moreFollowers) {
+    if (const int c = columns[layout.unknownOffset[j]]; c >= 0)
+      triplets->emplace_back(row, c, 1.0);
+  }
+  for (const int j : coupling.moreLeaders) {
+    if (const int c = columns[layout.unknownOffset[j]]; c >= 0)
+      triplets->emplace_back(row, c, -coupling.multiplier);
+  }
 }
 
 /// World twist of one unknown, positions in Lc: a point p moves by omega x p + v per unit of the unknown.
@@ -278,6 +291,10 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
     } else if (joint.kind == ConnectionKind::Coupling) {
       // Both ends are 1-DOF tree joints (the readers check it): one linear row in their unknowns.
       rows = layout.unknownCount[joint.follower] == 1 && layout.unknownCount[joint.leader] == 1 ? 1 : 0;
+      for (const int more : joint.moreFollowers)
+        rows = layout.unknownCount[more] == 1 ? rows : 0;
+      for (const int more : joint.moreLeaders)
+        rows = layout.unknownCount[more] == 1 ? rows : 0;
     } else {
       rows = residualRows(joint.type);
     }
