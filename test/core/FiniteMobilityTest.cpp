@@ -71,6 +71,55 @@ TEST(FiniteMobility, OnlyTheFlatPoseOfTheChangePointFourBarIsSingular) {
   EXPECT_TRUE(flat.redundantJoints.empty());
 }
 
+/// Two flat change-point four-bars on one ground, the second 1 m above the first (its names end in "_2").
+MechanismDescription twoFlatFourBars() {
+  MechanismDescription m = changePointFourBar(0.0);
+  const MechanismDescription other = changePointFourBar(0.0);
+  const Eigen::Vector3d up(0.0, 1.0, 0.0);
+  auto renamed = [](const std::string& name) { return name == "ground" ? name : name + "_2"; };
+  for (size_t l = 1; l < other.links.size(); ++l) {
+    LinkDescription link = other.links[l];
+    link.name = renamed(link.name);
+    for (Eigen::Vector3d& point : link.visualPath)
+      point += up;
+    m.links.push_back(link);
+  }
+  for (Connection connection : other.connections) {
+    connection.name += "_2";
+    connection.link1 = renamed(connection.link1);
+    connection.link2 = renamed(connection.link2);
+    connection.frame.translation() += up;
+    m.connections.push_back(connection);
+  }
+  m.name = "two_flat_four_bars";
+  return m;
+}
+
+TEST(FiniteMobility, TheDimensionAtASingularPoseIsTheBranchesNotTheSingularSets) {
+  // Stepped along a motion that keeps the pose singular, the nullity there is the singular set's, not the
+  // branches'. A floating base carries the flat four-bar to other flat poses: first order 2 + 3, the branches
+  // 1 + 3 (before: finite 5, not singular, the redundancy structural).
+  MechanismDescription floating = changePointFourBar(0.0);
+  floating.links.insert(floating.links.begin(), LinkDescription{"world", {}, std::nullopt});
+  const MobilityReport onFloatingBase = analyzeDescription(floating, AnalysisMode::Planar);
+  EXPECT_EQ(onFloatingBase.dof, 5);
+  EXPECT_EQ(onFloatingBase.grublerKutzbachDof, 4);
+  EXPECT_EQ(onFloatingBase.finiteDof, 4);
+  EXPECT_TRUE(onFloatingBase.singular);
+  ASSERT_EQ(onFloatingBase.redundantConstraints.size(), 1u);
+  EXPECT_EQ(onFloatingBase.redundantConstraints[0].cause, "configuration");
+  // Two flat four-bars: each one's own motion leaves the other flat. First order 2 + 2, the branches 1 + 1
+  // (before: finite 3).
+  const MobilityReport two = analyzeDescription(twoFlatFourBars(), AnalysisMode::Planar);
+  EXPECT_EQ(two.dof, 4);
+  EXPECT_EQ(two.grublerKutzbachDof, 2);
+  EXPECT_EQ(two.finiteDof, 2);
+  EXPECT_TRUE(two.singular);
+  ASSERT_EQ(two.redundantConstraints.size(), 2u);
+  for (const RedundantConstraint& c : two.redundantConstraints)
+    EXPECT_EQ(c.cause, "configuration") << c.equation;
+}
+
 TEST(FiniteMobility, StructuralRedundancyIsNotSingular) {
   // Bennett: 3 redundant equations at every pose of its motion, all structural.
   const MobilityReport bennett = analyzeOrFail(urdfPath("bennett.urdf"), AnalysisMode::Spatial).report;

@@ -29,6 +29,9 @@ constexpr double kReturned = 0.25;
 constexpr double kExtends = 0.05;
 /// Random combinations of first-order motions sampled at a singular pose, beyond the basis directions.
 constexpr int kRandomSamples = 4;
+/// The share of a random combination added to each basis direction sampled at a singular pose [-]: enough to
+/// leave the singular set by far more than the rank tolerance after one step (kStep times this).
+constexpr double kGenericShare = 0.3;
 /// The second-order test forms Q_ω for up to this many first-order motions (d (d + 1) / 2 entries each).
 constexpr int kMaxSecondOrderMotions = 64;
 /// Stresses are split into structural and configuration ones densely up to this many.
@@ -198,15 +201,18 @@ FiniteMobility analyzeFiniteMobility(const CoordinateModel& model, const Eigen::
     std::normal_distribution<double> normal;
     int finite = 0;
     for (int sample = 0; sample < d + kRandomSamples; ++sample) {
-      Eigen::VectorXd direction;
-      if (sample < d) {
-        direction = directions.col(sample);
-      } else {
-        Eigen::VectorXd c(d);
-        for (int a = 0; a < d; ++a)
-          c(a) = normal(random);
-        direction = directions * c;
-      }
+      // Every direction is generic: a basis direction, with a random combination of all of them added. A step
+      // along a basis direction alone may stay on the singular set, whose nullity is not the dimension of the
+      // branch around it: a floating base's rigid motion carries a flat four-bar to another flat pose
+      // (nullity 2 + 3, the branches 1 + 3), and one flat four-bar's own motion leaves a second one flat (two
+      // flat four-bars: nullity 1 + 2, the branches 1 + 1). A generic step lands off it, where the nullity is
+      // the dimension of the branch it reached.
+      Eigen::VectorXd c(d);
+      for (int a = 0; a < d; ++a)
+        c(a) = normal(random);
+      Eigen::VectorXd direction = directions * c.normalized();
+      if (sample < d)
+        direction = directions.col(sample) + kGenericShare * direction;
       const auto [stepped, projected] = step(direction);
       (void)stepped;
       if ((projected.first - q).norm() < kReturned * kStep)
