@@ -697,19 +697,14 @@ class Reader {
                (leaders.empty() ? pending.follower : pending.leader) + "': no joint to couple on its side");
     }
     if (leaders.size() + followers.size() > 2) {
-      for (const int j : leaders.size() > 1 ? leaders : followers) {
-        const JointType type = mechanism_.joints[static_cast<size_t>(j)].type;
-        if (type != JointType::Revolute && type != JointType::Continuous)
-          fail("coupling", pending.name,
-               "sums the values of joint '" + mechanism_.joints[static_cast<size_t>(j)].name +
-                   "', which is not revolute; only revolute joint values are summed");
-      }
-      for (const int j : leaders.size() > 1 ? followers : leaders) {
-        const JointType type = mechanism_.joints[static_cast<size_t>(j)].type;
-        if (type != JointType::Revolute && type != JointType::Continuous)
-          fail("coupling", pending.name,
-               "couples joint '" + mechanism_.joints[static_cast<size_t>(j)].name +
-                   "' to a sum of revolute joint values; it is not revolute");
+      for (const std::vector<int>* path : {&leaders, &followers}) {
+        for (const int j : *path) {
+          const Joint& joint = mechanism_.joints[static_cast<size_t>(j)];
+          if (joint.type != JointType::Revolute && joint.type != JointType::Continuous)
+            fail("coupling", pending.name,
+                 "joint '" + joint.name + "' on a path from the links' common ancestor is not revolute; " +
+                     "only revolute joint values are summed");
+        }
       }
     }
     coupling.leader = leaders.front();
