@@ -134,6 +134,11 @@ INSTANTIATE_TEST_SUITE_P(
                     ""},
         // 3d: a ball at C, so in space: the five-bar's 2 plus closure_B spinning on its pin; 6*6-25-6-3 = 2.
         DialectCase{"five_bar_gepetto.urdf", "five_bar_3d.yaml", AnalysisMode::Auto, "spatial", 3, 2, 1, ""},
+        // Drake's <drake:ball_constraint>: a ball, as the MJCF connect below.
+        DialectCase{"four_bar_drake_ball.urdf", "", AnalysisMode::Auto, "spatial", 1, 0, 1,
+                    "four_bar_ball_loop_joint.urdf"},
+        DialectCase{"four_bar_drake_ball.sdf", "", AnalysisMode::Auto, "spatial", 1, 0, 1,
+                    "four_bar_ball_loop_joint.urdf"},
         // MJCF connect is a ball: 6*3 - 5*3 - 3 = 0, the planar motion makes one equation redundant.
         DialectCase{"four_bar_mjcf.xml", "", AnalysisMode::Auto, "spatial", 1, 0, 1,
                     "four_bar_ball_loop_joint.urdf"},
@@ -770,6 +775,48 @@ TEST(Readers, MjcfWeldHoldsTwoBodiesTogether) {
   EXPECT_EQ(spatial.dof, 0);
   EXPECT_EQ(spatial.grublerKutzbachDof, -4);
   EXPECT_EQ(spatial.numRedundant, 4);
+}
+
+TEST(Readers, DrakeBallConstraintNeedsEveryPart) {
+  // Drake requires all four children; a missing one is one line naming the constraint, never a dropped loop.
+  const std::string text = readTextFile(formatPath("four_bar_drake_ball.urdf"));
+  const Mechanism m = readOrFail(formatPath("four_bar_drake_ball.urdf"));
+  const Joint& ball = m.joints[*m.findJoint("ball_constraint_0")];
+  EXPECT_EQ(ball.kind, ConnectionKind::LoopJoint);
+  EXPECT_EQ(ball.type, JointType::Spherical);
+  EXPECT_TRUE(ball.frame2.translation().isApprox(Eigen::Vector3d(0, 0.3, 0)));
+  for (const std::string part : {"body_A", "p_BQ"}) {
+    std::string cut = text;
+    const size_t at = cut.find("<drake:ball_constraint_" + part);
+    cut.erase(at, cut.find("/>", at) + 2 - at);
+    const Result<Mechanism> bad = readMechanismFromString(cut, "cut.urdf");
+    ASSERT_FALSE(isOk(bad)) << part;
+    const std::string line = diagnosticOf(bad).toString();
+    EXPECT_NE(line.find("ball_constraint_0"), std::string::npos) << line;
+    EXPECT_NE(line.find("missing <drake:ball_constraint_" + part), std::string::npos) << line;
+  }
+}
+
+TEST(SdfReader, DrakeBallConstraintClosesAtTheWrittenPoseAndOtherNamespacesWarn) {
+  // The point on the rocker is written in its SDFormat frame (at C), not its pin's: read right, the loop
+  // closes at the written pose with no assembly.
+  const std::string path = formatPath("four_bar_drake_ball.sdf");
+  const MobilityReport report = reportOf(readOrFail(path), AnalysisMode::Auto);
+  EXPECT_LT(report.closureResidualBefore, 1e-12);
+  EXPECT_EQ(report.assembly.iterations, 0);
+  // libsdformat keeps an element of another namespace silently; the reader says it is not read.
+  std::string text = readTextFile(path);
+  text.replace(text.find("    <drake:ball_constraint>"), 0, "<drake:linear_bushing_rpy/>");
+  const Result<Mechanism> bushing = readMechanismFromString(text, "bushing.sdf");
+  ASSERT_TRUE(isOk(bushing)) << diagnosticOf(bushing).toString();
+  EXPECT_TRUE(anyContains(warningTexts(valueOf(bushing)), "drake:linear_bushing_rpy", "is not read"));
+  // A point that is not three numbers is one line.
+  text = readTextFile(path);
+  text.replace(text.find(">0 0 0</drake:ball_constraint_p_BQ>"), 6, ">0 0");
+  const Result<Mechanism> bad = readMechanismFromString(text, "bad.sdf");
+  ASSERT_FALSE(isOk(bad));
+  EXPECT_NE(diagnosticOf(bad).toString().find("p_BQ '0 0' is not three numbers"), std::string::npos)
+      << diagnosticOf(bad).toString();
 }
 
 TEST(Readers, ClosureFileFramesOfJointsAndLoopNames) {

@@ -62,6 +62,27 @@ Eigen::Isometry3d toEigen(const ignition::math::Pose3d& pose) {
   return frame;
 }
 
+/// "x y z" (blanks around and between): exactly three numbers, read as the URDF reader reads them (no
+/// locale).
+bool threeNumbers(const std::string& text, Eigen::Vector3d& out) {
+  const char* at = text.c_str();
+  for (int i = 0; i < 3; ++i) {
+    while (io_detail::isSpace(*at))
+      ++at;
+    const char* end = at;
+    while (*end != '\0' && !io_detail::isSpace(*end))
+      ++end;
+    const std::optional<double> value = end == at ? std::nullopt : io_detail::parseNumber(at, end);
+    if (!value)
+      return false;
+    out[i] = *value;
+    at = end;
+  }
+  while (io_detail::isSpace(*at))
+    ++at;
+  return *at == '\0';
+}
+
 class SdfConverter {
  public:
   SdfConverter(const sdf::Model& model, std::string file) : model_(model), file_(std::move(file)) {
@@ -77,6 +98,8 @@ class SdfConverter {
     if (std::optional<Diagnostic> d = addLinks())
       return *d;
     if (std::optional<Diagnostic> d = addJoints())
+      return *d;
+    if (std::optional<Diagnostic> d = addCustomElements())
       return *d;
     return std::move(mechanism_);
   }
@@ -248,6 +271,75 @@ class SdfConverter {
           return d;
         mechanism_.joints.push_back(joint);
       }
+    }
+    return std::nullopt;
+  }
+
+  /**
+   * The model's elements of other namespaces, which libsdformat keeps without a word: Drake's
+   * <drake:ball_constraint> (point P of body A stays at point Q of body B, MultibodyPlant::AddBallConstraint)
+   * becomes a spherical loop joint "ball_constraint_<n>"; <drake:collision_filter_group> carries nothing for
+   * mobility; any other is a warning, so no constraint is dropped silently.
+   */
+  std::optional<Diagnostic> addCustomElements() {
+    int balls = 0;
+    for (sdf::ElementPtr e = model_.Element()->GetFirstElement(); e; e = e->GetNextElement()) {
+      const std::string tag = e->GetName();
+      if (tag.find(':') == std::string::npos || tag == "drake:collision_filter_group")
+        continue;
+      if (tag != "drake:ball_constraint") {
+        warn(tag, e->HasAttribute("name") ? e->GetAttribute("name")->GetAsString() : "",
+             "unknown element <" + tag + "> is not read");
+        continue;
+      }
+      Joint joint;
+      joint.name = "ball_constraint_" + std::to_string(balls++);
+      if (!names_.insert(joint.name).second)
+        return makeDiagnostic(file_, tag, joint.name, "has the name of another joint");
+      joint.kind = ConnectionKind::LoopJoint;
+      joint.type = JointType::Spherical;
+      auto text = [&](const char* part, std::string& out) -> std::optional<Diagnostic> {
+        const std::string child = std::string("drake:ball_constraint_") + part;
+        if (!e->HasElement(child) || !e->GetElement(child)->GetValue())
+          return makeDiagnostic(file_, tag, joint.name, "missing <" + child + ">");
+        out = e->GetElement(child)->GetValue()->GetAsString();
+        return std::nullopt;
+      };
+      std::string bodies[2], points[2];
+      for (int side = 0; side < 2; ++side) {
+        if (std::optional<Diagnostic> d = text(side == 0 ? "body_A" : "body_B", bodies[side]))
+          return d;
+        if (std::optional<Diagnostic> d = text(side == 0 ? "p_AP" : "p_BQ", points[side]))
+          return d;
+      }
+      int links[2];
+      for (int side = 0; side < 2; ++side) {
+        const auto it = linkIndex_.find(bodies[side]);
+        if (it == linkIndex_.end())
+          return makeDiagnostic(file_, tag, joint.name,
+                                std::string(side == 0 ? "body_A" : "body_B") + " '" + bodies[side] +
+                                    "' is not a link of the model");
+        links[side] = it->second;
+        Eigen::Vector3d point;
+        if (!threeNumbers(points[side], point))
+          return makeDiagnostic(
+              file_, tag, joint.name,
+              std::string(side == 0 ? "p_AP" : "p_BQ") + " '" + points[side] + "' is not three numbers");
+        for (int i = 0; i < 3; ++i) {
+          if (const std::optional<std::string> why = io_detail::checkRange(point[i]))
+            return makeDiagnostic(file_, tag, joint.name, std::string(side == 0 ? "p_AP " : "p_BQ ") + *why);
+        }
+        // The point is in the body's SDFormat frame; a link's frame here is its tree joint's.
+        Eigen::Isometry3d& frame = side == 0 ? joint.frame1 : joint.frame2;
+        frame = Eigen::Isometry3d::Identity();
+        frame.translation() = linkFrame_[static_cast<size_t>(links[side])].inverse() *
+                              (writtenPose_[static_cast<size_t>(links[side])] * point);
+      }
+      if (links[0] == links[1])
+        return makeDiagnostic(file_, tag, joint.name, "joins link '" + bodies[0] + "' to itself");
+      joint.link1 = links[0];
+      joint.link2 = links[1];
+      mechanism_.joints.push_back(joint);
     }
     return std::nullopt;
   }

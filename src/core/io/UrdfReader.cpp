@@ -98,11 +98,23 @@ constexpr std::array<const char*, 6> kIgnoredElements = {
     "gazebo", "transmission", "ros2_control", "material", "sensor", "drake:collision_filter_group"};
 
 /// Top-level elements this reader understands, in the order of their kinds (TopLevel).
-constexpr std::array<const char*, 7> kReadElements = {
-    "link", "joint", "distance_constraint", "cable", "loop_joint", "loop", "coupling"};
+constexpr std::array<const char*, 8> kReadElements = {
+    "link",       "joint", "distance_constraint",   "cable",
+    "loop_joint", "loop",  "drake:ball_constraint", "coupling"};
 
 /// What a top-level element is: its index in kReadElements, kIgnored or kUnknown.
-enum TopLevel : int { kLink, kJoint, kDistance, kCable, kLoopJoint, kLoop, kCoupling, kIgnored, kUnknown };
+enum TopLevel : int {
+  kLink,
+  kJoint,
+  kDistance,
+  kCable,
+  kLoopJoint,
+  kLoop,
+  kDrakeBall,
+  kCoupling,
+  kIgnored,
+  kUnknown
+};
 
 TopLevel classify(const char* tag) {
   for (size_t i = 0; i < kReadElements.size(); ++i) {
@@ -117,8 +129,9 @@ TopLevel classify(const char* tag) {
 }
 
 /// kReadElements in alphabetical order: the order the "did you mean" hints are given in.
-constexpr std::array<const char*, 7> kKnownSorted = {"cable", "coupling", "distance_constraint", "joint",
-                                                     "link",  "loop",     "loop_joint"};
+constexpr std::array<const char*, 8> kKnownSorted = {
+    "cable", "coupling", "distance_constraint", "drake:ball_constraint", "joint",
+    "link",  "loop",     "loop_joint"};
 
 /// Blanks as `std::istream >> std::string` splits on them (the "C" locale's isspace).
 bool isBlank(char c) {
@@ -223,18 +236,23 @@ class Reader {
       readTwoEnded(e, ConnectionKind::DistanceConstraint);
     for (Element e : byKind[kCable])
       readTwoEnded(e, ConnectionKind::Cable);
-    // <loop_joint> and <loop> in document order, mixed.
+    // <loop_joint>, <loop> and <drake:ball_constraint> in document order, mixed.
     std::vector<Element>& loops = byKind[kLoopJoint];
-    if (!byKind[kLoop].empty()) {
+    if (!byKind[kLoop].empty() || !byKind[kDrakeBall].empty()) {
       loops.clear();
       forEachTopLevel([&](Element e) {
         const TopLevel kind = classify(e.name());
-        if (kind == kLoopJoint || kind == kLoop)
+        if (kind == kLoopJoint || kind == kLoop || kind == kDrakeBall)
           loops.push_back(e);
       });
     }
-    for (Element e : loops)
-      readLoop(e);
+    int drakeBalls = 0;
+    for (Element e : loops) {
+      if (classify(e.name()) == kDrakeBall)
+        readDrakeBall(e, drakeBalls++);
+      else
+        readLoop(e);
+    }
     for (Element e : byKind[kCoupling])
       readCoupling(e);
     for (const PendingCoupling& coupling : couplings_)
@@ -581,6 +599,39 @@ class Reader {
         fail("cable", joint.name, "length must be positive, got " + std::string(attributeOf(e, "length")));
     }
     readEnds(e, "link1", "link2", kindName, joint);
+    appendClaimed(std::move(joint));
+  }
+
+  /**
+   * Drake's <drake:ball_constraint> (its URDF form: <drake:ball_constraint_body_A name=.../>, _p_AP
+   * value=..., _body_B, _p_BQ; MultibodyPlant::AddBallConstraint): point P of body A stays at point Q of body
+   * B, a spherical loop joint. Drake names none; this is "ball_constraint_<n>", the n-th in the file. Every
+   * child is required, as Drake requires them.
+   */
+  void readDrakeBall(Element e, int n) {
+    const std::string kind = e.name();
+    Joint joint;
+    joint.name = "ball_constraint_" + std::to_string(n);
+    claimNextName(kind, joint.name);
+    joint.kind = ConnectionKind::LoopJoint;
+    joint.type = JointType::Spherical;
+    checkChildren(e, kind, joint.name,
+                  {"drake:ball_constraint_body_A", "drake:ball_constraint_p_AP",
+                   "drake:ball_constraint_body_B", "drake:ball_constraint_p_BQ"});
+    auto required = [&](const char* tag, const char* attribute) {
+      Element c = e.child(tag);
+      if (!c || attributeOf(c, attribute) == nullptr)
+        fail(kind, joint.name, std::string("missing <") + tag + " " + attribute + "=\"...\"/>");
+      return attributeOf(c, attribute);
+    };
+    joint.link1 = link(required("drake:ball_constraint_body_A", "name"), kind, joint.name, "body_A");
+    joint.link2 = link(required("drake:ball_constraint_body_B", "name"), kind, joint.name, "body_B");
+    if (joint.link1 == joint.link2)
+      fail(kind, joint.name, "joins link '" + mechanism_.links[joint.link1].name + "' to itself");
+    joint.frame1.translation() =
+        vector(required("drake:ball_constraint_p_AP", "value"), kind, joint.name, Label{"p_AP", ""});
+    joint.frame2.translation() =
+        vector(required("drake:ball_constraint_p_BQ", "value"), kind, joint.name, Label{"p_BQ", ""});
     appendClaimed(std::move(joint));
   }
 
