@@ -797,6 +797,52 @@ TEST(Readers, DrakeBallConstraintNeedsEveryPart) {
   }
 }
 
+TEST(Readers, DrakeJointsAreTreeJoints) {
+  // An RSSR as Drake writes it: the crank carries the rod on a <drake:joint type="ball">, and the rod's other
+  // end is held on the rocker by a <drake:ball_constraint>. Crank about z at the origin, B (0.2, 0, 0);
+  // rocker about y at D (1, 0, 0), C (1, 0, 0.3). 6*3 - 5*2 - 3 - 3 = 2: the rocker's motion and the rod's
+  // spin.
+  const std::string rssr = R"(<robot name="rssr" xmlns:drake="http://drake.mit.edu">
+    <link name="ground"/><link name="crank"/><link name="rod"/><link name="rocker"/>
+    <joint name="input" type="continuous"><parent link="ground"/><child link="crank"/><axis xyz="0 0 1"/></joint>
+    <drake:joint name="ball_b" type="ball"><parent link="crank"/><child link="rod"/><origin xyz="0.2 0 0"/>
+    </drake:joint>
+    <joint name="output" type="continuous"><parent link="ground"/><child link="rocker"/><origin xyz="1 0 0"/>
+      <axis xyz="0 1 0"/></joint>
+    <drake:ball_constraint><drake:ball_constraint_body_A name="rod"/><drake:ball_constraint_p_AP value="0.8 0 0.3"/>
+      <drake:ball_constraint_body_B name="rocker"/><drake:ball_constraint_p_BQ value="0 0 0.3"/></drake:ball_constraint>
+  </robot>)";
+  const Result<Mechanism> m = readMechanismFromString(rssr, "rssr.urdf");
+  ASSERT_TRUE(isOk(m)) << diagnosticOf(m).toString();
+  EXPECT_TRUE(valueOf(m).warnings.empty());
+  const Joint& ball = valueOf(m).joints[*valueOf(m).findJoint("ball_b")];
+  EXPECT_EQ(ball.kind, ConnectionKind::TreeJoint);
+  EXPECT_EQ(ball.type, JointType::Spherical);
+  const MobilityReport r = reportOf(valueOf(m), AnalysisMode::Auto);
+  EXPECT_EQ(r.mode, "spatial");
+  EXPECT_EQ(r.dof, 2);
+  EXPECT_EQ(r.grublerKutzbachDof, 2);
+  EXPECT_EQ(r.numRedundant, 0);
+  EXPECT_EQ(r.passiveDof, 1);
+  EXPECT_EQ(r.assembly.iterations, 0);  // the written pose closes
+  // Drake's universal joint turns about x, then y; a type Drake builds otherwise (a screw) is one line.
+  std::string universal = rssr;
+  universal.replace(universal.find(R"(type="ball")"), 11, R"(type="universal")");
+  const Result<Mechanism> u = readMechanismFromString(universal, "rssr.urdf");
+  ASSERT_TRUE(isOk(u)) << diagnosticOf(u).toString();
+  const Joint& cross = valueOf(u).joints[*valueOf(u).findJoint("ball_b")];
+  EXPECT_EQ(cross.type, JointType::Universal);
+  EXPECT_EQ(cross.axis, Eigen::Vector3d::UnitX());
+  EXPECT_EQ(cross.axis2, Eigen::Vector3d::UnitY());
+  std::string screw = rssr;
+  screw.replace(screw.find(R"(type="ball")"), 11, R"(type="screw")");
+  const Result<Mechanism> bad = readMechanismFromString(screw, "rssr.urdf");
+  ASSERT_FALSE(isOk(bad));
+  EXPECT_NE(diagnosticOf(bad).toString().find("drake:joint 'ball_b': type 'screw' is not read"),
+            std::string::npos)
+      << diagnosticOf(bad).toString();
+}
+
 TEST(SdfReader, DrakeBallConstraintClosesAtTheWrittenPoseAndOtherNamespacesWarn) {
   // The point on the rocker is written in its SDFormat frame (at C), not its pin's: read right, the loop
   // closes at the written pose with no assembly.

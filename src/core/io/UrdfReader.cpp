@@ -117,6 +117,9 @@ enum TopLevel : int {
 };
 
 TopLevel classify(const char* tag) {
+  // Drake's custom tree joints (ball, universal, planar) are read with the <joint>s, in document order.
+  if (tag[0] == 'd' && std::strcmp(tag, "drake:joint") == 0)
+    return kJoint;
   for (size_t i = 0; i < kReadElements.size(); ++i) {
     if (tag[0] == kReadElements[i][0] && std::strcmp(tag, kReadElements[i]) == 0)
       return static_cast<TopLevel>(i);
@@ -166,6 +169,17 @@ std::optional<JointType> parseLoopType(std::string_view type) {
   return parseJointType(
       type, {JointType::Revolute, JointType::Continuous, JointType::Prismatic, JointType::Cylindrical,
              JointType::Spherical, JointType::Universal, JointType::Fixed});
+}
+
+/// Drake's <drake:joint> types, as its URDF parser builds them: ball (BallRpyJoint), universal, planar.
+std::optional<JointType> parseDrakeType(std::string_view type) {
+  if (type == "ball")
+    return JointType::Spherical;
+  if (type == "universal")
+    return JointType::Universal;
+  if (type == "planar")
+    return JointType::Planar;
+  return std::nullopt;
 }
 
 /// Tree joints take URDF's types.
@@ -476,7 +490,14 @@ class Reader {
                  "' already has a parent joint; close loops with <loop_joint>");
       }
       const char* type = attributeOf(e, "type");
-      const std::optional<JointType> jointType = parseTreeType(type == nullptr ? "" : type);
+      const bool drake = std::strcmp(e.name(), "drake:joint") == 0;
+      const std::optional<JointType> jointType =
+          drake ? parseDrakeType(type == nullptr ? "" : type) : parseTreeType(type == nullptr ? "" : type);
+      if (drake && !jointType) {
+        fail("drake:joint", name,
+             "type '" + std::string(type == nullptr ? "" : type) +
+                 "' is not read (ball, universal, planar are)");
+      }
       if (!jointType) {
         fail("joint", name,
              "type '" + std::string(type == nullptr ? "" : type) +
@@ -494,7 +515,13 @@ class Reader {
             io_detail::makeOriginFrame(vector(attributeOf(origin, "xyz"), "joint", name, "origin xyz"),
                                        vector(attributeOf(origin, "rpy"), "joint", name, "origin rpy"));
       }
-      if (joint.type != JointType::Fixed && joint.type != JointType::Floating) {
+      if (joint.type == JointType::Universal) {
+        // Drake's UniversalJoint turns about its frame's x on the parent, then y on the child; it reads no
+        // axis.
+        joint.axis = Eigen::Vector3d::UnitX();
+        joint.axis2 = Eigen::Vector3d::UnitY();
+      } else if (joint.type != JointType::Fixed && joint.type != JointType::Floating &&
+                 joint.type != JointType::Spherical) {
         // URDF's default, but a forgotten axis turns a planar linkage spatial: said, never silent.
         if (!axisElement) {
           warn("joint", name,
