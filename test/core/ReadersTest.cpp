@@ -63,6 +63,16 @@ std::vector<std::string> warningTexts(const Mechanism& mechanism) {
   return texts;
 }
 
+/// The one-line refusal of reading @p text as @p source; a failure of the test when it reads.
+std::string refusalOf(const std::string& text, const std::string& source) {
+  const Result<Mechanism> m = readMechanismFromString(text, source);
+  if (isOk(m)) {
+    ADD_FAILURE() << source << " was read";
+    return "";
+  }
+  return diagnosticOf(m).toString();
+}
+
 bool anyContains(const std::vector<std::string>& texts, const std::string& a, const std::string& b = "") {
   for (const std::string& t : texts) {
     if (t.find(a) != std::string::npos && t.find(b) != std::string::npos)
@@ -356,15 +366,12 @@ TEST(Couplings, BetweenLinksSumTheJointValuesFromTheirCommonAncestor) {
   }
   // A link that is the other's ancestor has no joint on its side, and a prismatic joint cannot join a sum of
   // angles: one line each, never a dropped constraint.
-  const Result<Mechanism> ancestor = readMechanismFromString(legWithRotor("thigh", "shank"), "leg.urdf");
-  ASSERT_FALSE(isOk(ancestor));
-  EXPECT_NE(diagnosticOf(ancestor).toString().find("is an ancestor of"), std::string::npos);
+  EXPECT_NE(refusalOf(legWithRotor("thigh", "shank"), "leg.urdf").find("is an ancestor of"),
+            std::string::npos);
   std::string sliding = legWithRotor("shank", "rotor");
   sliding.replace(sliding.find("'knee' type='revolute'"), std::string("'knee' type='revolute'").size(),
                   "'knee' type='prismatic'");
-  const Result<Mechanism> mixed = readMechanismFromString(sliding, "leg.urdf");
-  ASSERT_FALSE(isOk(mixed));
-  EXPECT_NE(diagnosticOf(mixed).toString().find("not revolute"), std::string::npos);
+  EXPECT_NE(refusalOf(sliding, "leg.urdf").find("not revolute"), std::string::npos);
 }
 
 TEST(Couplings, HoldWhenEitherJointIsDriven) {
@@ -777,6 +784,27 @@ TEST(Readers, MjcfWeldHoldsTwoBodiesTogether) {
   EXPECT_EQ(spatial.numRedundant, 4);
 }
 
+TEST(Readers, ARefusalNamesTheWarningBeforeIt) {
+  // The misspelt <jiont> is not read, so l2 is a second root: the refusal's one line says both.
+  const std::string line = refusalOf(
+      "<robot name='a'><link name='l1'/><link name='l2'/><jiont name='j' type='fixed'><parent link='l1'/>"
+      "<child link='l2'/></jiont><frobnicate/></robot>",
+      "typo.urdf");
+  EXPECT_NE(line.find("two roots"), std::string::npos) << line;
+  EXPECT_NE(line.find("(after the warning jiont 'j': unknown element <jiont> is not read, and 1 more)"),
+            std::string::npos)
+      << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+  // The same in SDFormat: a misspelt <lnk> leaves the joint's child unknown to libsdformat.
+  std::string sdf = readTextFile(formatPath("four_bar_drake_ball.sdf"));
+  sdf.replace(sdf.find("<link name=\"crank\">"), 5, "<lnk");
+  sdf.replace(sdf.find("</link>"), 7, "</lnk>");
+  const std::string sdfLine = refusalOf(sdf, "typo.sdf");
+  EXPECT_NE(sdfLine.find("(after the warning lnk 'crank': unknown element <lnk> is not read"),
+            std::string::npos)
+      << sdfLine;
+}
+
 TEST(Readers, DrakeBallConstraintNeedsEveryPart) {
   // Drake requires all four children; a missing one is one line naming the constraint, never a dropped loop.
   const std::string text = readTextFile(formatPath("four_bar_drake_ball.urdf"));
@@ -789,9 +817,7 @@ TEST(Readers, DrakeBallConstraintNeedsEveryPart) {
     std::string cut = text;
     const size_t at = cut.find("<drake:ball_constraint_" + part);
     cut.erase(at, cut.find("/>", at) + 2 - at);
-    const Result<Mechanism> bad = readMechanismFromString(cut, "cut.urdf");
-    ASSERT_FALSE(isOk(bad)) << part;
-    const std::string line = diagnosticOf(bad).toString();
+    const std::string line = refusalOf(cut, "cut.urdf");
     EXPECT_NE(line.find("ball_constraint_0"), std::string::npos) << line;
     EXPECT_NE(line.find("missing <drake:ball_constraint_" + part), std::string::npos) << line;
   }
@@ -836,11 +862,8 @@ TEST(Readers, DrakeJointsAreTreeJoints) {
   EXPECT_EQ(cross.axis2, Eigen::Vector3d::UnitY());
   std::string screw = rssr;
   screw.replace(screw.find(R"(type="ball")"), 11, R"(type="screw")");
-  const Result<Mechanism> bad = readMechanismFromString(screw, "rssr.urdf");
-  ASSERT_FALSE(isOk(bad));
-  EXPECT_NE(diagnosticOf(bad).toString().find("drake:joint 'ball_b': type 'screw' is not read"),
-            std::string::npos)
-      << diagnosticOf(bad).toString();
+  const std::string screwLine = refusalOf(screw, "rssr.urdf");
+  EXPECT_NE(screwLine.find("drake:joint 'ball_b': type 'screw' is not read"), std::string::npos) << screwLine;
 }
 
 TEST(SdfReader, DrakeBallConstraintClosesAtTheWrittenPoseAndOtherNamespacesWarn) {
@@ -859,10 +882,8 @@ TEST(SdfReader, DrakeBallConstraintClosesAtTheWrittenPoseAndOtherNamespacesWarn)
   // A point that is not three numbers is one line.
   text = readTextFile(path);
   text.replace(text.find(">0 0 0</drake:ball_constraint_p_BQ>"), 6, ">0 0");
-  const Result<Mechanism> bad = readMechanismFromString(text, "bad.sdf");
-  ASSERT_FALSE(isOk(bad));
-  EXPECT_NE(diagnosticOf(bad).toString().find("p_BQ '0 0' is not three numbers"), std::string::npos)
-      << diagnosticOf(bad).toString();
+  const std::string line = refusalOf(text, "bad.sdf");
+  EXPECT_NE(line.find("p_BQ '0 0' is not three numbers"), std::string::npos) << line;
 }
 
 TEST(Readers, ClosureFileFramesOfJointsAndLoopNames) {

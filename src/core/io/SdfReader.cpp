@@ -10,6 +10,7 @@
 
 #include <sdf/sdf.hh>
 
+#include "RefusalLine.hpp"
 #include "SdfReaderPlugin.hpp"
 #include "XmlValues.hpp"
 #include "mobility_analysis/Tolerances.hpp"
@@ -95,12 +96,10 @@ class SdfConverter {
     for (uint64_t i = 0; i < model_.ModelCount(); ++i) {
       warn("model", model_.ModelByIndex(i)->Name(), "is a nested model and is not read");
     }
-    if (std::optional<Diagnostic> d = addLinks())
-      return *d;
-    if (std::optional<Diagnostic> d = addJoints())
-      return *d;
-    if (std::optional<Diagnostic> d = addCustomElements())
-      return *d;
+    for (auto add : {&SdfConverter::addLinks, &SdfConverter::addJoints, &SdfConverter::addCustomElements}) {
+      if (std::optional<Diagnostic> d = (this->*add)())
+        return io_detail::refusalAfter(*d, mechanism_.warnings);
+    }
     return std::move(mechanism_);
   }
 
@@ -420,7 +419,8 @@ Result<Mechanism> readSdfWithLibsdformat(const std::string& sdfText, const std::
                error.Code() == sdf::ErrorCode::VERSION_DEPRECATED) {
       warnings.push_back(makeDiagnostic(file, kind, name, message));
     } else {
-      return makeDiagnostic(file, kind, name, "libsdformat rejected the model: " + message);
+      return io_detail::refusalAfter(
+          makeDiagnostic(file, kind, name, "libsdformat rejected the model: " + message), warnings);
     }
   }
   const sdf::Model* model = root.Model();

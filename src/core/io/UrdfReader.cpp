@@ -14,6 +14,7 @@
 
 #include "../SideTask.hpp"
 #include "NameIndex.hpp"
+#include "RefusalLine.hpp"
 #include "UrdfHalves.hpp"
 #include "XmlHalves.hpp"
 #include "XmlValues.hpp"
@@ -213,6 +214,9 @@ struct PendingCoupling {
 class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) { mechanism_.file = file_; }
+
+  /// The warnings given so far (after a refusal: those before it).
+  const std::vector<Diagnostic>& warnings() const { return mechanism_.warnings; }
 
   /// The mechanism of the <robot> element @p robot; with @p rest, of the two halves of one (XmlHalves): the
   /// children of @p robot, then those of @p rest.
@@ -939,10 +943,11 @@ std::optional<XmlFault> wellFormedError(const pugi::xml_document& document) {
 Result<Mechanism> readRobot(Element robot, Element rest, const std::string& file) {
   if (!robot)
     return makeDiagnostic(file, "xml", "", "the root element is not <robot>");
+  Reader reader(file);
   try {
-    return Reader(file).read(robot, rest);
+    return reader.read(robot, rest);
   } catch (const ReadFailure& failure) {
-    return failure.diagnostic;
+    return io_detail::refusalAfter(failure.diagnostic, reader.warnings());
   }
 }
 
