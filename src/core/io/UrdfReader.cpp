@@ -508,7 +508,7 @@ class Reader {
                  "' is not a URDF tree type (revolute, continuous, prismatic, fixed, floating, planar)");
       }
       // Written in place at the end of the connections (reserved: no reallocation), not built apart and moved
-      // in: a Joint is 400 bytes. A refusal below abandons the whole mechanism, this joint with it.
+      // in: a Joint is 448 bytes. A refusal below abandons the whole mechanism, this joint with it.
       Joint& joint = mechanism_.joints.emplace_back();
       joint.kind = ConnectionKind::TreeJoint;
       joint.type = *jointType;
