@@ -1,5 +1,6 @@
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,9 +38,9 @@ struct JointValueOperand {
 struct CouplingTerms {
   JointValueOperand follower;
   JointValueOperand leader;
-  /// Joint values added to the follower's and to the leader's (Joint::moreFollowers, Joint::moreLeaders:
-  /// revolute ones only, so in the same unit).
-  std::vector<JointValueOperand> moreFollowers, moreLeaders;
+  /// Weighted joint values added to the follower's and to the leader's (Joint::moreFollowers,
+  /// Joint::moreLeaders: revolute ones only, so in the same unit).
+  std::vector<std::pair<JointValueOperand, double>> moreFollowers, moreLeaders;
   double multiplier = 1.0;  ///< m, in follower units per leader unit (normalised lengths for prismatic).
   double offset = 0.0;      ///< c, in follower units.
 };

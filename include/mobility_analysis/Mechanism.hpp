@@ -31,6 +31,13 @@ enum class ConnectionKind { TreeJoint, DistanceConstraint, Cable, LoopJoint, Cou
 /// Passive cables constrain while taut; active cables are the driver and constrain nothing.
 enum class CableType { Passive, Active };
 
+/// One joint's value in a coupling's sum, with its weight (1 for generalized_rbda's paths; a fixed tendon's
+/// coefficient, relative to the first joint's, for MJCF).
+struct WeightedJoint {
+  int joint = -1;  ///< Index into Mechanism::joints: a 1-DOF tree joint.
+  double weight = 1.0;
+};
+
 /// A rigid link; its frame is the URDF link frame.
 struct Link {
   std::string name;
@@ -62,11 +69,12 @@ struct Joint {
   int follower = -1;
   double multiplier = 1.0;
   double offset = 0.0;
-  /// Coupling only: further 1-DOF tree joints whose values add to the leader's and to the follower's
+  /// Coupling only: further 1-DOF tree joints whose weighted values add to the leader's and to the follower's
   /// (generalized_rbda's coupling of two links sums the joint values on each link's path from their nearest
-  /// common ancestor): value(follower) + sum moreFollowers = multiplier (value(leader) + sum moreLeaders) +
-  /// offset. Usually empty.
-  std::vector<int> moreLeaders, moreFollowers;
+  /// common ancestor; an MJCF tendon equality weighs them by the fixed tendons' coefficients):
+  /// value(follower) + sum w value(moreFollowers) = multiplier (value(leader) + sum w value(moreLeaders)) +
+  /// offset. Usually empty; every joint in them is revolute (the readers check it).
+  std::vector<WeightedJoint> moreLeaders, moreFollowers;
 };
 
 /// Joint values by tree-joint name [rad] or [m].

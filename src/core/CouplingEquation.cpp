@@ -69,10 +69,10 @@ std::map<int, Eigen::Vector3d> gradientByElement(const CouplingTerms& terms, con
   std::map<int, Eigen::Vector3d> byElement;
   jointValueGradient(terms.follower, model, q, 1.0, byElement);
   jointValueGradient(terms.leader, model, q, -terms.multiplier, byElement);
-  for (const JointValueOperand& o : terms.moreFollowers)
-    jointValueGradient(o, model, q, 1.0, byElement);
-  for (const JointValueOperand& o : terms.moreLeaders)
-    jointValueGradient(o, model, q, -terms.multiplier, byElement);
+  for (const auto& [o, weight] : terms.moreFollowers)
+    jointValueGradient(o, model, q, weight, byElement);
+  for (const auto& [o, weight] : terms.moreLeaders)
+    jointValueGradient(o, model, q, -terms.multiplier * weight, byElement);
   return byElement;
 }
 
@@ -93,10 +93,10 @@ double evaluateCoupling(const CouplingTerms& terms, const CoordinateModel& model
                         const Eigen::Ref<const Eigen::VectorXd>& q) {
   double follower = evaluateJointValue(terms.follower, model, q);
   double leader = evaluateJointValue(terms.leader, model, q);
-  for (const JointValueOperand& o : terms.moreFollowers)
-    follower += evaluateJointValue(o, model, q);
-  for (const JointValueOperand& o : terms.moreLeaders)
-    leader += evaluateJointValue(o, model, q);
+  for (const auto& [o, weight] : terms.moreFollowers)
+    follower += weight * evaluateJointValue(o, model, q);
+  for (const auto& [o, weight] : terms.moreLeaders)
+    leader += weight * evaluateJointValue(o, model, q);
   return follower - terms.multiplier * leader - terms.offset;
 }
 
@@ -197,10 +197,10 @@ void addCouplingEquation(ModelBuilder& builder, int j) {
   CouplingTerms terms;
   terms.follower = makeOperand(coupling.follower);
   terms.leader = makeOperand(coupling.leader);
-  for (const int t : coupling.moreFollowers)
-    terms.moreFollowers.push_back(makeOperand(t));
-  for (const int t : coupling.moreLeaders)
-    terms.moreLeaders.push_back(makeOperand(t));
+  for (const WeightedJoint& t : coupling.moreFollowers)
+    terms.moreFollowers.emplace_back(makeOperand(t.joint), t.weight);
+  for (const WeightedJoint& t : coupling.moreLeaders)
+    terms.moreLeaders.emplace_back(makeOperand(t.joint), t.weight);
   // v_f [SI] = m v_l [SI] + c, with prismatic values in normalised lengths: scale by Lc.
   const double lc = model.characteristicLength;
   const double followerScale = terms.follower.prismatic ? lc : 1.0;

@@ -153,10 +153,10 @@ double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, 
       return it == values.end() ? 0.0 : it->second;
     };
     double follower = value(joint.follower), leader = value(joint.leader);
-    for (const int j : joint.moreFollowers)
-      follower += value(j);
-    for (const int j : joint.moreLeaders)
-      leader += value(j);
+    for (const WeightedJoint& j : joint.moreFollowers)
+      follower += j.weight * value(j.joint);
+    for (const WeightedJoint& j : joint.moreLeaders)
+      leader += j.weight * value(j.joint);
     const double residual = std::abs(follower - joint.multiplier * leader - joint.offset);
     return mechanism.joints[joint.follower].type == JointType::Prismatic ? residual : lengthScale * residual;
   }

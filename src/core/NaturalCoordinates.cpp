@@ -370,10 +370,11 @@ std::string describeEquation(const CoordinateModel& model, int row) {
         return o.prismatic ? "s(" + label(o.aHead) + " -> " + label(o.bHead) + ")"
                            : "angle(" + label(o.aHead) + ", " + label(o.bHead) + ")";
       };
-      auto sum = [&](const JointValueOperand& first, const std::vector<JointValueOperand>& more) {
+      auto sum = [&](const JointValueOperand& first,
+                     const std::vector<std::pair<JointValueOperand, double>>& more) {
         std::string text = value(first);
-        for (const JointValueOperand& o : more)
-          text += " + " + value(o);
+        for (const auto& [o, weight] : more)
+          text += " + " + (weight == 1.0 ? "" : number(weight) + " ") + value(o);
         return more.empty() ? text : "(" + text + ")";
       };
       return sum(terms.follower, terms.moreFollowers) + " = " + number(terms.multiplier) + " " +

@@ -763,6 +763,61 @@ TEST(DeepTrees, AChainOfTwoHundredThousandLinksLoads) {
   EXPECT_NE(diagnosticOf(c).toString().find("cycle"), std::string::npos);
 }
 
+/// The value reached by joint @p name in @p report (NaN when it is not listed).
+double reachedValue(const MobilityReport& report, const std::string& name) {
+  for (const JointValue& v : report.positions) {
+    if (v.name == name)
+      return v.value;
+  }
+  return std::nan("");
+}
+
+TEST(Readers, MjcfTendonEqualityOverFixedTendonsIsACoupling) {
+  // Three hinges in a row; fixed tendons are weighted sums of joint values (L = sum coef qpos), and a tendon
+  // equality holds L1 - L1_0 = c0 + c1 (L2 - L2_0).
+  auto finger = [](const std::string& tendons, const std::string& equality) {
+    return R"(<mujoco model="finger"><worldbody>
+      <body name="a"><joint name="knuckle" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.01"/>
+        <body name="b" pos="0.3 0 0"><joint name="middle" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/>
+          <body name="c" pos="0.2 0 0"><joint name="tip" type="hinge" axis="0 0 1"/><geom type="capsule" fromto="0 0 0 0.1 0 0" size="0.01"/>
+          </body></body></body></worldbody><tendon>)" +
+           tendons + "</tendon><equality>" + equality + "</equality></mujoco>";
+  };
+  // One tendon held at its reference length: knuckle - 2 tip = 0 (knuckle = 2 tip). Three hinges, one
+  // coupling: planar DOF 2.
+  const Result<Mechanism> coupler = readMechanismFromString(
+      finger(
+          R"(<fixed name="coupler"><joint joint="knuckle" coef="1"/><joint joint="tip" coef="-2"/></fixed>)",
+          R"(<tendon name="hold" tendon1="coupler"/>)"),
+      "finger.xml");
+  ASSERT_TRUE(isOk(coupler)) << diagnosticOf(coupler).toString();
+  EXPECT_TRUE(valueOf(coupler).warnings.empty());
+  const MobilityReport held = reportOf(valueOf(coupler), AnalysisMode::Auto, {{"tip", 0.2}, {"middle", 0.1}});
+  EXPECT_EQ(held.dof, 2);
+  EXPECT_EQ(held.grublerKutzbachDof, 2);
+  EXPECT_NEAR(reachedValue(held, "knuckle"), 0.4, 1e-9);
+  // Two tendons, weighted sums on both sides: knuckle + 3 middle = 0.05 + 0.5 (2 tip + middle); the written
+  // pose is off by the offset and is assembled onto it.
+  const Result<Mechanism> two = readMechanismFromString(
+      finger(R"(<fixed name="base"><joint joint="knuckle" coef="1"/><joint joint="middle" coef="3"/></fixed>
+                <fixed name="end"><joint joint="tip" coef="2"/><joint joint="middle" coef="1"/></fixed>)",
+             R"(<tendon name="follow" tendon1="base" tendon2="end" polycoef="0.05 0.5 0 0 0"/>)"),
+      "finger.xml");
+  ASSERT_TRUE(isOk(two)) << diagnosticOf(two).toString();
+  const MobilityReport followed = reportOf(valueOf(two), AnalysisMode::Auto, {{"tip", 0.3}, {"middle", 0.2}});
+  EXPECT_EQ(followed.dof, 2);
+  EXPECT_NEAR(reachedValue(followed, "knuckle"), 0.05 + 0.5 * (2.0 * 0.3 + 0.2) - 3.0 * 0.2, 1e-9);
+  // A spatial tendon's length is no sum of joint values: a warning, not a silent drop.
+  const Result<Mechanism> spatial = readMechanismFromString(
+      R"(<mujoco model="string"><worldbody><site name="s0" pos="0 0.1 0"/>
+        <body name="a"><joint name="knuckle" type="hinge" axis="0 0 1"/><geom size="0.01"/><site name="s1" pos="0.3 0 0"/>
+        </body></worldbody><tendon><spatial name="string"><site site="s0"/><site site="s1"/></spatial></tendon>
+        <equality><tendon name="pull" tendon1="string"/></equality></mujoco>)",
+      "string.xml");
+  ASSERT_TRUE(isOk(spatial)) << diagnosticOf(spatial).toString();
+  EXPECT_TRUE(anyContains(warningTexts(valueOf(spatial)), "tendon 'pull'", "not a fixed tendon over hinges"));
+}
+
 TEST(Readers, MjcfWeldHoldsTwoBodiesTogether) {
   // Two cranks on parallel hinges, welded to each other: nothing moves. In the plane 3*2 - 2*2 - 3 = -1, so
   // one equation is redundant; in space 6*2 - 5*2 - 6 = -4, four.

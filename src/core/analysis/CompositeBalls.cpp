@@ -40,8 +40,10 @@ std::vector<LinkConnections> connectionsOfLinks(const Mechanism& mechanism) {
     if (joint.kind == ConnectionKind::Coupling) {
       // A coupled revolute is driven by another joint: not a free ball.
       std::vector<int> coupled = {joint.leader, joint.follower};
-      coupled.insert(coupled.end(), joint.moreLeaders.begin(), joint.moreLeaders.end());
-      coupled.insert(coupled.end(), joint.moreFollowers.begin(), joint.moreFollowers.end());
+      for (const std::vector<WeightedJoint>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
+        for (const WeightedJoint& j : *more)
+          coupled.push_back(j.joint);
+      }
       for (const int t : coupled) {
         if (t >= 0) {
           const Joint& c = mechanism.joints[static_cast<size_t>(t)];
@@ -188,9 +190,9 @@ MechanismWithBalls mergeCompositeBalls(const Mechanism& mechanism, const LinkPos
       continue;
     joint.leader = joint.leader >= 0 ? newJoint[static_cast<size_t>(joint.leader)] : -1;
     joint.follower = joint.follower >= 0 ? newJoint[static_cast<size_t>(joint.follower)] : -1;
-    for (std::vector<int>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
-      for (int& t : *more)
-        t = newJoint[static_cast<size_t>(t)];
+    for (std::vector<WeightedJoint>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
+      for (WeightedJoint& t : *more)
+        t.joint = newJoint[static_cast<size_t>(t.joint)];
     }
   }
   return merged;

@@ -67,8 +67,8 @@ std::optional<Diagnostic> retypeJoint(Mechanism& mechanism, const std::string& n
     return std::nullopt;
   }
   for (const Joint& coupling : mechanism.joints) {
-    const auto inSum = [&](const std::vector<int>& more) {
-      return std::find(more.begin(), more.end(), *found) != more.end();
+    const auto inSum = [&](const std::vector<WeightedJoint>& more) {
+      return std::any_of(more.begin(), more.end(), [&](const WeightedJoint& j) { return j.joint == *found; });
     };
     if (coupling.kind == ConnectionKind::Coupling &&
         (coupling.leader == *found || coupling.follower == *found || inSum(coupling.moreLeaders) ||

@@ -181,10 +181,11 @@ class MjcfConverter {
   std::optional<Diagnostic> addEquality(int e) {
     const std::string name = equalityName(e);
     const int type = m_.eq_type[e];
-    const char* kind = type == mjEQ_CONNECT ? "connect"
-                       : type == mjEQ_WELD  ? "weld"
-                       : type == mjEQ_JOINT ? "joint"
-                                            : "equality";
+    const char* kind = type == mjEQ_CONNECT  ? "connect"
+                       : type == mjEQ_WELD   ? "weld"
+                       : type == mjEQ_JOINT  ? "joint"
+                       : type == mjEQ_TENDON ? "tendon"
+                                             : "equality";
     if (!m_.eq_active[e]) {
       mechanism_.warnings.push_back(
           makeDiagnostic(file_, kind, name, "is inactive in the model and is not read"));
@@ -232,14 +233,8 @@ class MjcfConverter {
       auto oneFreedom = [&](int j) { return m_.jnt_type[j] == mjJNT_HINGE || m_.jnt_type[j] == mjJNT_SLIDE; };
       if (!oneFreedom(follower) || !oneFreedom(leader))
         return makeDiagnostic(file_, kind, name, "couples a joint that is not a hinge or slide");
-      if (data[2] != 0.0 || data[3] != 0.0 || data[4] != 0.0) {
-        mechanism_.warnings.push_back(makeDiagnostic(
-            file_, kind, name, "has polynomial terms above the linear one; only offset and slope are read"));
-      }
-      for (int i = 0; i < 2; ++i) {
-        if (const std::optional<std::string> why = io_detail::checkRange(data[i]))
-          return makeDiagnostic(file_, kind, name, "polycoef " + *why);
-      }
+      if (std::optional<Diagnostic> d = readLinearPolycoef(data, kind, name))
+        return d;
       Joint joint;
       joint.name = name;
       if (std::optional<Diagnostic> d = claim(kind, name))
@@ -255,8 +250,92 @@ class MjcfConverter {
       couplings_.push_back(joint);
       return std::nullopt;
     }
+    if (type == mjEQ_TENDON)
+      return addTendonEquality(e, name, data);
     mechanism_.warnings.push_back(
-        makeDiagnostic(file_, kind, name, "is a tendon or distance equality, which is not read"));
+        makeDiagnostic(file_, kind, name, "is an equality of a type that is not read"));
+    return std::nullopt;
+  }
+
+  /// A joint or tendon equality's polycoef: offset and slope are read (a refusal when out of range), higher
+  /// terms are a warning.
+  std::optional<Diagnostic> readLinearPolycoef(const mjtNum* data, const char* kind,
+                                               const std::string& name) {
+    if (data[2] != 0.0 || data[3] != 0.0 || data[4] != 0.0) {
+      mechanism_.warnings.push_back(makeDiagnostic(
+          file_, kind, name, "has polynomial terms above the linear one; only offset and slope are read"));
+    }
+    for (int i = 0; i < 2; ++i) {
+      if (const std::optional<std::string> why = io_detail::checkRange(data[i]))
+        return makeDiagnostic(file_, kind, name, "polycoef " + *why);
+    }
+    return std::nullopt;
+  }
+
+  /// The hinges and coefficients of fixed tendon @p t (length = sum coef qpos), or nothing when it is not one
+  /// over hinges alone (a spatial tendon's length is no sum of joint values; a slide would mix units).
+  std::optional<std::vector<WeightedJoint>> fixedTendonOverHinges(int t) const {
+    std::vector<WeightedJoint> terms;
+    for (int k = m_.tendon_adr[t]; k < m_.tendon_adr[t] + m_.tendon_num[t]; ++k) {
+      const int j = m_.wrap_objid[k];
+      if (m_.wrap_type[k] != mjWRAP_JOINT || m_.jnt_type[j] != mjJNT_HINGE)
+        return std::nullopt;
+      terms.push_back(WeightedJoint{treeJointOf_[j], m_.wrap_prm[k]});
+    }
+    return terms;
+  }
+
+  /**
+   * MuJoCo's tendon equality over fixed tendons: L1 - L1_0 = c0 + c1 (L2 - L2_0) (without tendon2: = c0),
+   * with L = sum coef qpos, so in the joint values v = q - q0 one linear coupling. It is written in the first
+   * joint of tendon1 (divided by its coefficient): the rest of tendon1 are moreFollowers; tendon2's first
+   * joint is the leader and the rest moreLeaders, or without tendon2 tendon1's second joint is the leader.
+   */
+  std::optional<Diagnostic> addTendonEquality(int e, const std::string& name, const mjtNum* data) {
+    const char* kind = "tendon";
+    const int tendon1 = m_.eq_obj1id[e], tendon2 = m_.eq_obj2id[e];
+    std::optional<std::vector<WeightedJoint>> first = fixedTendonOverHinges(tendon1);
+    std::optional<std::vector<WeightedJoint>> second =
+        tendon2 >= 0 ? fixedTendonOverHinges(tendon2) : std::vector<WeightedJoint>{};
+    if (!first || !second) {
+      mechanism_.warnings.push_back(makeDiagnostic(
+          file_, kind, name, "couples a tendon that is not a fixed tendon over hinges, and is not read"));
+      return std::nullopt;
+    }
+    if (std::optional<Diagnostic> d = readLinearPolycoef(data, kind, name))
+      return d;
+    // Leader side: tendon2 scaled by the slope, or tendon1's second joint moved across.
+    std::vector<WeightedJoint> leaders;
+    for (const WeightedJoint& j : *second)
+      leaders.push_back(WeightedJoint{j.joint, data[1] * j.weight});
+    std::vector<WeightedJoint>& followers = *first;
+    if (tendon2 < 0 && followers.size() >= 2) {
+      leaders.push_back(WeightedJoint{followers[1].joint, -followers[1].weight});
+      followers.erase(followers.begin() + 1);
+    }
+    if (followers.empty() || leaders.empty() || followers[0].weight == 0.0 || leaders[0].weight == 0.0) {
+      mechanism_.warnings.push_back(makeDiagnostic(
+          file_, kind, name, "holds one joint at a value (or has a zero coefficient) and is not read"));
+      return std::nullopt;
+    }
+    Joint joint;
+    joint.name = name;
+    if (std::optional<Diagnostic> d = claim(kind, name))
+      return d;
+    joint.kind = ConnectionKind::Coupling;
+    const double f = followers[0].weight, l = leaders[0].weight;
+    joint.follower = followers[0].joint;
+    joint.leader = leaders[0].joint;
+    joint.multiplier = l / f;
+    joint.offset = data[0] / f;
+    for (size_t k = 1; k < followers.size(); ++k)
+      joint.moreFollowers.push_back(WeightedJoint{followers[k].joint, followers[k].weight / f});
+    for (size_t k = 1; k < leaders.size(); ++k)
+      joint.moreLeaders.push_back(WeightedJoint{leaders[k].joint, leaders[k].weight / l});
+    joint.type = mechanism_.joints[joint.follower].type;
+    joint.link1 = mechanism_.joints[joint.follower].link2;
+    joint.link2 = mechanism_.joints[joint.leader].link2;
+    couplings_.push_back(joint);
     return std::nullopt;
   }
 

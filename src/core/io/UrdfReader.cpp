@@ -791,8 +791,10 @@ class Reader {
     }
     coupling.leader = leaders.front();
     coupling.follower = followers.front();
-    coupling.moreLeaders.assign(leaders.begin() + 1, leaders.end());
-    coupling.moreFollowers.assign(followers.begin() + 1, followers.end());
+    for (size_t k = 1; k < leaders.size(); ++k)
+      coupling.moreLeaders.push_back(WeightedJoint{leaders[k], 1.0});
+    for (size_t k = 1; k < followers.size(); ++k)
+      coupling.moreFollowers.push_back(WeightedJoint{followers[k], 1.0});
   }
 
   void addCoupling(const PendingCoupling& pending) {
@@ -816,9 +818,9 @@ class Reader {
       coupleLinks(pending, joint);
       for (const int j : {joint.leader, joint.follower})
         resolve(mechanism_.joints[static_cast<size_t>(j)].name, "joint");
-      for (const std::vector<int>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
-        for (const int j : *more)
-          resolve(mechanism_.joints[static_cast<size_t>(j)].name, "joint");
+      for (const std::vector<WeightedJoint>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
+        for (const WeightedJoint& j : *more)
+          resolve(mechanism_.joints[static_cast<size_t>(j.joint)].name, "joint");
       }
     } else {
       joint.leader = resolve(pending.leader, pending.kind == "joint" ? "mimic joint" : "predecessor");

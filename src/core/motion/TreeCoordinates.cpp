@@ -64,10 +64,10 @@ void addCouplingRow(const Mechanism& mechanism, const ClosureLayout& layout, con
   const double leaderScale = leader.type == JointType::Prismatic ? lc : 1.0;
   // The joints summed with either end are revolute (the reader checks it), in the ends' unit.
   double followerValue = unknownValue(follower, poses, lc), leaderValue = unknownValue(leader, poses, lc);
-  for (const int j : coupling.moreFollowers)
-    followerValue += unknownValue(mechanism.joints[j], poses, lc);
-  for (const int j : coupling.moreLeaders)
-    leaderValue += unknownValue(mechanism.joints[j], poses, lc);
+  for (const WeightedJoint& j : coupling.moreFollowers)
+    followerValue += j.weight * unknownValue(mechanism.joints[j.joint], poses, lc);
+  for (const WeightedJoint& j : coupling.moreLeaders)
+    leaderValue += j.weight * unknownValue(mechanism.joints[j.joint], poses, lc);
   double r =
       followerValue - (coupling.multiplier * leaderValue * leaderScale + coupling.offset) / followerScale;
   if (follower.type != JointType::Prismatic)
@@ -81,13 +81,13 @@ void addCouplingRow(const Mechanism& mechanism, const ClosureLayout& layout, con
     triplets->emplace_back(row, fc, 1.0);
   if (lcol >= 0)
     triplets->emplace_back(row, lcol, -coupling.multiplier * leaderScale / followerScale);
-  for (const int j : coupling.moreFollowers) {
-    if (const int c = columns[layout.unknownOffset[j]]; c >= 0)
-      triplets->emplace_back(row, c, 1.0);
+  for (const WeightedJoint& j : coupling.moreFollowers) {
+    if (const int c = columns[layout.unknownOffset[j.joint]]; c >= 0)
+      triplets->emplace_back(row, c, j.weight);
   }
-  for (const int j : coupling.moreLeaders) {
-    if (const int c = columns[layout.unknownOffset[j]]; c >= 0)
-      triplets->emplace_back(row, c, -coupling.multiplier);
+  for (const WeightedJoint& j : coupling.moreLeaders) {
+    if (const int c = columns[layout.unknownOffset[j.joint]]; c >= 0)
+      triplets->emplace_back(row, c, -coupling.multiplier * j.weight * leaderScale / followerScale);
   }
 }
 
@@ -291,10 +291,10 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
     } else if (joint.kind == ConnectionKind::Coupling) {
       // Both ends are 1-DOF tree joints (the readers check it): one linear row in their unknowns.
       rows = layout.unknownCount[joint.follower] == 1 && layout.unknownCount[joint.leader] == 1 ? 1 : 0;
-      for (const int more : joint.moreFollowers)
-        rows = layout.unknownCount[more] == 1 ? rows : 0;
-      for (const int more : joint.moreLeaders)
-        rows = layout.unknownCount[more] == 1 ? rows : 0;
+      for (const std::vector<WeightedJoint>* more : {&joint.moreFollowers, &joint.moreLeaders}) {
+        for (const WeightedJoint& j : *more)
+          rows = layout.unknownCount[j.joint] == 1 ? rows : 0;
+      }
     } else {
       rows = residualRows(joint.type);
     }
