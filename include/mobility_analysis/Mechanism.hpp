@@ -3,6 +3,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -104,6 +105,25 @@ struct Mechanism {
   /// @return Index of the tree joint whose child is @p link, if any (none for the root).
   std::optional<int> findParentJoint(int link) const;
 };
+
+/// @return The 1-DOF tree joints coupling @p coupling ties: its follower, its leader, then the joints summed
+///         with either (Joint::moreFollowers, Joint::moreLeaders).
+std::vector<int> coupledJoints(const Joint& coupling);
+
+/**
+ * @brief The two sides of coupling @p coupling's equation at the joint values @p value(joint index):
+ *        value(follower) + sum w value(moreFollowers), and value(leader) + sum w value(moreLeaders); the
+ *        equation is follower side = multiplier * leader side + offset.
+ */
+template <class JointValue>
+std::pair<double, double> couplingSides(const Joint& coupling, JointValue&& value) {
+  double follower = value(coupling.follower), leader = value(coupling.leader);
+  for (const WeightedJoint& j : coupling.moreFollowers)
+    follower += j.weight * value(j.joint);
+  for (const WeightedJoint& j : coupling.moreLeaders)
+    leader += j.weight * value(j.joint);
+  return {follower, leader};
+}
 
 /// @return The dialect's spelling of @p type ("revolute", …).
 const char* toString(JointType type);

@@ -152,11 +152,7 @@ double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, 
       const auto it = values.find(mechanism.joints[j].name);
       return it == values.end() ? 0.0 : it->second;
     };
-    double follower = value(joint.follower), leader = value(joint.leader);
-    for (const WeightedJoint& j : joint.moreFollowers)
-      follower += j.weight * value(j.joint);
-    for (const WeightedJoint& j : joint.moreLeaders)
-      leader += j.weight * value(j.joint);
+    const auto [follower, leader] = couplingSides(joint, value);
     const double residual = std::abs(follower - joint.multiplier * leader - joint.offset);
     return mechanism.joints[joint.follower].type == JointType::Prismatic ? residual : lengthScale * residual;
   }

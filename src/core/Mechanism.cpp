@@ -29,6 +29,15 @@ std::optional<int> Mechanism::findParentJoint(int link) const {
   return std::nullopt;
 }
 
+std::vector<int> coupledJoints(const Joint& coupling) {
+  std::vector<int> joints = {coupling.follower, coupling.leader};
+  for (const std::vector<WeightedJoint>* more : {&coupling.moreFollowers, &coupling.moreLeaders}) {
+    for (const WeightedJoint& j : *more)
+      joints.push_back(j.joint);
+  }
+  return joints;
+}
+
 const char* toString(JointType type) {
   switch (type) {
     case JointType::Revolute:

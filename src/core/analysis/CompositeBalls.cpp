@@ -39,12 +39,7 @@ std::vector<LinkConnections> connectionsOfLinks(const Mechanism& mechanism) {
     const Joint& joint = mechanism.joints[j];
     if (joint.kind == ConnectionKind::Coupling) {
       // A coupled revolute is driven by another joint: not a free ball.
-      std::vector<int> coupled = {joint.leader, joint.follower};
-      for (const std::vector<WeightedJoint>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
-        for (const WeightedJoint& j : *more)
-          coupled.push_back(j.joint);
-      }
-      for (const int t : coupled) {
+      for (const int t : coupledJoints(joint)) {
         if (t >= 0) {
           const Joint& c = mechanism.joints[static_cast<size_t>(t)];
           add(c.link1, -1);

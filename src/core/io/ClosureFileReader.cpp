@@ -67,12 +67,10 @@ std::optional<Diagnostic> retypeJoint(Mechanism& mechanism, const std::string& n
     return std::nullopt;
   }
   for (const Joint& coupling : mechanism.joints) {
-    const auto inSum = [&](const std::vector<WeightedJoint>& more) {
-      return std::any_of(more.begin(), more.end(), [&](const WeightedJoint& j) { return j.joint == *found; });
-    };
-    if (coupling.kind == ConnectionKind::Coupling &&
-        (coupling.leader == *found || coupling.follower == *found || inSum(coupling.moreLeaders) ||
-         inSum(coupling.moreFollowers)))
+    if (coupling.kind != ConnectionKind::Coupling)
+      continue;
+    const std::vector<int> coupled = coupledJoints(coupling);
+    if (std::find(coupled.begin(), coupled.end(), *found) != coupled.end())
       return makeDiagnostic(
           file, "joint_name", name,
           "is coupled to another joint by '" + coupling.name + "'; it cannot become " + type);

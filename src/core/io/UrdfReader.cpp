@@ -799,15 +799,20 @@ class Reader {
 
   void addCoupling(const PendingCoupling& pending) {
     const std::string& element = pending.kind == "joint" ? pending.follower : pending.name;
+    // A tree joint of one freedom, or the refusal naming it in its @p role.
+    auto checkOneFreedom = [&](int found, const char* role) {
+      const Joint& tree = mechanism_.joints[static_cast<size_t>(found)];
+      if (!isOneFreedom(tree)) {
+        fail(pending.kind, element,
+             std::string(role) + " '" + tree.name + "' is " + toString(tree.type) +
+                 "; only revolute, continuous and prismatic joints can be coupled");
+      }
+    };
     auto resolve = [&](const std::string& jointName, const char* role) {
       const int found = connectionIndex_.find(jointName, mechanism_.joints);
       if (found < 0 || mechanism_.joints[found].kind != ConnectionKind::TreeJoint)
         fail(pending.kind, element, std::string(role) + " '" + jointName + "' is not a tree joint");
-      if (!isOneFreedom(mechanism_.joints[found])) {
-        fail(pending.kind, element,
-             std::string(role) + " '" + jointName + "' is " + toString(mechanism_.joints[found].type) +
-                 "; only revolute, continuous and prismatic joints can be coupled");
-      }
+      checkOneFreedom(found, role);
       return found;
     };
     Joint joint;
@@ -815,13 +820,9 @@ class Reader {
     claimName("coupling", joint.name);
     joint.kind = ConnectionKind::Coupling;
     if (pending.byLink) {
-      coupleLinks(pending, joint);
-      for (const int j : {joint.leader, joint.follower})
-        resolve(mechanism_.joints[static_cast<size_t>(j)].name, "joint");
-      for (const std::vector<WeightedJoint>* more : {&joint.moreLeaders, &joint.moreFollowers}) {
-        for (const WeightedJoint& j : *more)
-          resolve(mechanism_.joints[static_cast<size_t>(j.joint)].name, "joint");
-      }
+      coupleLinks(pending, joint);  // tree joints, found on the links' paths
+      for (const int j : coupledJoints(joint))
+        checkOneFreedom(j, "joint");
     } else {
       joint.leader = resolve(pending.leader, pending.kind == "joint" ? "mimic joint" : "predecessor");
       joint.follower = resolve(pending.follower, "successor");

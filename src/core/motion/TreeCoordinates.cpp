@@ -63,11 +63,8 @@ void addCouplingRow(const Mechanism& mechanism, const ClosureLayout& layout, con
   const double followerScale = follower.type == JointType::Prismatic ? lc : 1.0;
   const double leaderScale = leader.type == JointType::Prismatic ? lc : 1.0;
   // The joints summed with either end are revolute (the reader checks it), in the ends' unit.
-  double followerValue = unknownValue(follower, poses, lc), leaderValue = unknownValue(leader, poses, lc);
-  for (const WeightedJoint& j : coupling.moreFollowers)
-    followerValue += j.weight * unknownValue(mechanism.joints[j.joint], poses, lc);
-  for (const WeightedJoint& j : coupling.moreLeaders)
-    leaderValue += j.weight * unknownValue(mechanism.joints[j.joint], poses, lc);
+  const auto [followerValue, leaderValue] =
+      couplingSides(coupling, [&](int j) { return unknownValue(mechanism.joints[j], poses, lc); });
   double r =
       followerValue - (coupling.multiplier * leaderValue * leaderScale + coupling.offset) / followerScale;
   if (follower.type != JointType::Prismatic)
@@ -290,11 +287,10 @@ ClosureLayout makeClosureLayout(const Mechanism& mechanism, const LinkPoses& wri
       }
     } else if (joint.kind == ConnectionKind::Coupling) {
       // Both ends are 1-DOF tree joints (the readers check it): one linear row in their unknowns.
-      rows = layout.unknownCount[joint.follower] == 1 && layout.unknownCount[joint.leader] == 1 ? 1 : 0;
-      for (const std::vector<WeightedJoint>* more : {&joint.moreFollowers, &joint.moreLeaders}) {
-        for (const WeightedJoint& j : *more)
-          rows = layout.unknownCount[j.joint] == 1 ? rows : 0;
-      }
+      const std::vector<int> coupled = coupledJoints(joint);
+      rows = std::all_of(coupled.begin(), coupled.end(), [&](int j) { return layout.unknownCount[j] == 1; })
+                 ? 1
+                 : 0;
     } else {
       rows = residualRows(joint.type);
     }
