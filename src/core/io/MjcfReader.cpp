@@ -236,19 +236,11 @@ class MjcfConverter {
       if (std::optional<Diagnostic> d = readLinearPolycoef(data, kind, name))
         return d;
       Joint joint;
-      joint.name = name;
-      if (std::optional<Diagnostic> d = claim(kind, name))
-        return d;
-      joint.kind = ConnectionKind::Coupling;
       joint.follower = treeJointOf_[follower];
       joint.leader = treeJointOf_[leader];
-      joint.type = mechanism_.joints[joint.follower].type;
-      joint.link1 = mechanism_.joints[joint.follower].link2;
-      joint.link2 = mechanism_.joints[joint.leader].link2;
       joint.offset = data[0];
       joint.multiplier = data[1];
-      couplings_.push_back(joint);
-      return std::nullopt;
+      return addCoupling(kind, name, std::move(joint));
     }
     if (type == mjEQ_TENDON)
       return addTendonEquality(e, name, data);
@@ -319,10 +311,6 @@ class MjcfConverter {
       return std::nullopt;
     }
     Joint joint;
-    joint.name = name;
-    if (std::optional<Diagnostic> d = claim(kind, name))
-      return d;
-    joint.kind = ConnectionKind::Coupling;
     const double f = followers[0].weight, l = leaders[0].weight;
     joint.follower = followers[0].joint;
     joint.leader = leaders[0].joint;
@@ -332,10 +320,20 @@ class MjcfConverter {
       joint.moreFollowers.push_back(WeightedJoint{followers[k].joint, followers[k].weight / f});
     for (size_t k = 1; k < leaders.size(); ++k)
       joint.moreLeaders.push_back(WeightedJoint{leaders[k].joint, leaders[k].weight / l});
-    joint.type = mechanism_.joints[joint.follower].type;
-    joint.link1 = mechanism_.joints[joint.follower].link2;
-    joint.link2 = mechanism_.joints[joint.leader].link2;
-    couplings_.push_back(joint);
+    return addCoupling(kind, name, std::move(joint));
+  }
+
+  /// @p coupling (its joints, multiplier and offset set) named @p name, with its kind, type and links; kept
+  /// for after the loop joints (couplings_).
+  std::optional<Diagnostic> addCoupling(const char* kind, const std::string& name, Joint coupling) {
+    if (std::optional<Diagnostic> d = claim(kind, name))
+      return d;
+    coupling.name = name;
+    coupling.kind = ConnectionKind::Coupling;
+    coupling.type = mechanism_.joints[coupling.follower].type;
+    coupling.link1 = mechanism_.joints[coupling.follower].link2;
+    coupling.link2 = mechanism_.joints[coupling.leader].link2;
+    couplings_.push_back(std::move(coupling));
     return std::nullopt;
   }
 
