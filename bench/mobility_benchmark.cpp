@@ -52,9 +52,10 @@
 #include "EliminationOrders.hpp"
 #endif
 
+#include "HugePageHeap.hpp"
 #include "mobility_analysis/analysis/FiniteMobility.hpp"
-#include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/analysis/PassiveFreedoms.hpp"
+#include "mobility_analysis/io/ReadMechanism.hpp"
 #include "mobility_analysis/mobility_analysis.hpp"
 
 using namespace mobility_analysis;
@@ -237,11 +238,12 @@ int main(int argc, char** argv) {
     m = report.numConstraints;
     dof = report.dof;
     redundant = report.numRedundant;
+    // heap: the allocator and its options (HugePageHeap.hpp), the same for every method of this program.
     std::printf(
         "method=full file=%s coordinates=%d equations=%d dof=%d redundant=%d seconds=%.4f load_seconds=%.4f "
-        "analysis_seconds=%.4f json_bytes=%zu peak_mb=%.1f status=ok\n",
+        "analysis_seconds=%.4f json_bytes=%zu peak_mb=%.1f heap=%s status=ok\n",
         file.c_str(), n, m, dof, redundant, seconds(), loadSeconds, analysisSeconds, counter.bytes,
-        peakMegabytes());
+        peakMegabytes(), heapDescription().c_str());
     return 0;
   } else if (method == "finite") {
     // The finite-mobility and passive-freedom tests timed next to the plain first-order analysis they follow

@@ -1,0 +1,52 @@
+/// Every executable of the package (the CLI, the node, the benchmarks) runs on jemalloc with transparent huge
+/// pages. Why: a large report is dominated by first touches of fresh memory. A 10^5-link chain touches about
+/// 90 000 pages of 4 KiB; on the virtual machines we measure on, each first touch is a fault of several
+/// microseconds, 40-60 % of the whole report (perf: exc_page_fault). Huge pages of 2 MiB cut the faults by up
+/// to 512; jemalloc asks the kernel for them with madvise(MADV_HUGEPAGE), which works where the system's
+/// policy is "madvise" (Debian's default) without any system setting. Measured in bench/RESULTS.md, tenth
+/// round.
+///
+/// jemalloc reads its options from the global `malloc_conf` once, at start-up (jemalloc(3), TUNING); the
+/// environment variable MALLOC_CONF, read after it, still overrides any of them.
+///   thp:always              huge pages for every arena's memory
+///   metadata_thp:auto       and for jemalloc's own metadata once it grows past one huge page
+///   dirty_decay_ms:-1 ...   (one-shot tools only) never hand freed pages back: a report frees and
+///                           reallocates large buffers phase after phase, and each page handed back is
+///                           faulted in again.
+///                           The node keeps jemalloc's default decay (10 s): it lives long, and memory freed
+///                           after a big model returns to the system.
+/// The library itself (libmobility_analysis_core) leaves the allocator to whatever program links it.
+#include "HugePageHeap.hpp"
+
+#include <jemalloc/jemalloc.h>
+
+#ifndef MOBILITY_HEAP_OPTIONS
+#define MOBILITY_HEAP_OPTIONS "thp:always,metadata_thp:auto"
+#endif
+
+extern "C" {
+// NOLINTNEXTLINE(cppcoreguidelines-avoid-non-const-global-variables): the name and type jemalloc looks up
+const char* malloc_conf = MOBILITY_HEAP_OPTIONS;
+}
+
+namespace mobility_analysis {
+
+std::string heapDescription() {
+  const char* version = nullptr;
+  const char* thp = nullptr;
+  ssize_t dirtyDecay = 0;
+  std::size_t size = sizeof(const char*);
+  std::size_t decaySize = sizeof(ssize_t);
+  // mallctl answers 0 when the option exists; anything else means jemalloc is not the heap after all (a
+  // preloaded allocator, say), which the description says instead of guessing.
+  if (mallctl("version", &version, &size, nullptr, 0) != 0 ||
+      mallctl("opt.thp", &thp, &size, nullptr, 0) != 0 ||
+      mallctl("opt.dirty_decay_ms", &dirtyDecay, &decaySize, nullptr, 0) != 0) {
+    return "unknown";
+  }
+  std::string shortVersion(version);
+  shortVersion = shortVersion.substr(0, shortVersion.find('-'));
+  return "jemalloc-" + shortVersion + ",thp:" + thp + ",dirty_decay_ms:" + std::to_string(dirtyDecay);
+}
+
+}  // namespace mobility_analysis
