@@ -10,10 +10,13 @@
 /// environment variable MALLOC_CONF, read after it, still overrides any of them.
 ///   thp:always         huge pages for every arena's memory
 ///   metadata_thp:auto  and for jemalloc's own metadata once it grows past one huge page
-/// Freed pages go back to the system after jemalloc's default decay (10 s): never handing them back
-/// (dirty_decay_ms:-1) was no faster beyond the noise on the scaling families and took 21 % more memory on
-/// the 10^6-link chain (2.88 against 2.38 GB). The library itself (libmobility_analysis_core) leaves the
-/// allocator to whatever program links it.
+/// Freed pages go back to the system on jemalloc's default decay (10 s). Never handing them back
+/// (MALLOC_CONF=dirty_decay_ms:-1) spares the pages faulted in again: the 200 x 200 braced lattice's faults
+/// fall from 12 400 to 2 600 and its report from 2.4-3.2 to 2.2-2.4 s (one thread: 4.6 to 2.9 s), the
+/// 10^5-size families move within the noise, but the peak grows by up to 25 % (the 10^6-link chain 2.2-2.4 to
+/// 2.9 GB), and memory is the target we are closer to.
+///
+/// The library itself (libmobility_analysis_core) leaves the allocator to whatever program links it.
 #include "HugePageHeap.hpp"
 
 #include <jemalloc/jemalloc.h>
