@@ -1,10 +1,10 @@
 /// Every executable of the package (the CLI, the node, the benchmarks) runs on jemalloc with transparent huge
-/// pages. Why: a large report is dominated by first touches of fresh memory. A 10^5-link chain touches about
-/// 90 000 pages of 4 KiB; on the virtual machines we measure on, each first touch is a fault of several
-/// microseconds, 40-60 % of the whole report (perf: exc_page_fault). Huge pages of 2 MiB cut the faults by up
-/// to 512; jemalloc asks the kernel for them with madvise(MADV_HUGEPAGE), which works where the system's
-/// policy is "madvise" (Debian's default) without any system setting. Measured in bench/RESULTS.md, tenth
-/// round.
+/// pages. Why: a large report spends much of its time on first touches of fresh memory. A 10^5-link chain's
+/// report takes 92 000 page faults of 4 KiB; on the virtual machines we measure on, each costs microseconds,
+/// 27 % of the report's profile (perf: exc_page_fault), and the report is 1.2-2.3x faster without them.
+/// Huge pages of 2 MiB cut the faults by up to 512; jemalloc asks the kernel for them with
+/// madvise(MADV_HUGEPAGE), which works where the system's policy is "madvise" (Debian's default) without any
+/// system setting. Measured in bench/RESULTS.md, tenth round.
 ///
 /// jemalloc reads its options from the global `malloc_conf` once, at start-up (jemalloc(3), TUNING); the
 /// environment variable MALLOC_CONF, read after it, still overrides any of them.
