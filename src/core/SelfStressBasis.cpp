@@ -207,7 +207,13 @@ std::optional<StressEchelon> reduceStresses(const std::vector<SelfStress>& stres
     for (const auto& entry : stresses[s])
       enters[s] = std::max(enters[s], entry.first);
   }
-  const SparseJacobian Y = core_detail::stressMatrix(stresses, m, [](int) { return true; });
+  // The upward reduction cannot end above the lowest last row of a stress (that stress has no entry higher
+  // up to pivot on), and mostly ends there: Y is built from that row up, and whole only if the reduction goes
+  // further down. Rows of Y are the same either way, so is the answer. Why: the contract-order echelon of a
+  // 200 x 200 braced lattice has 5.9 10^6 entries, 0.86 10^6 of them from its lowest last row up (the
+  // cables'); the whole Y took 0.07-0.2 s of fresh memory for a reduction of 0.014 s.
+  const int lowestLast = numStresses == 0 ? 0 : *std::min_element(enters.begin(), enters.end());
+  SparseJacobian Y = core_detail::stressMatrix(stresses, m, [&](int r) { return r >= lowestLast; });
 
   // Rows from the last equation up, unscaled (the stresses are scaled instead, so a row of rounding noise
   // stays noise); the stress that the upward sweep met last is the preferred pivot. Once every stress has
@@ -239,6 +245,8 @@ std::optional<StressEchelon> reduceStresses(const std::vector<SelfStress>& stres
   for (int r = m - 1; r >= 0 && elimination.rank() < numStresses; --r) {
     if (budget.exceeded(elimination.storedEntries(), taken))
       return std::nullopt;
+    if (r == lowestLast - 1)
+      Y = core_detail::stressMatrix(stresses, m, [](int) { return true; });
     reduction.pivot[r] = elimination.addRow(Y, r, 1.0).dependent ? 0 : 1;
     taken += static_cast<size_t>(Y.outerIndexPtr()[r + 1] - Y.outerIndexPtr()[r]);
   }
