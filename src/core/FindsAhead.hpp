@@ -80,9 +80,9 @@ class FindsAhead {
   /// The trace limit the sweep will have reached, as far as the worker's rule has followed it.
   size_t traceLimitHint() const { return limitHint_.load(std::memory_order_relaxed); }
 
-  /// Whether the worker's latest find put the finder in space-first mode (the sweep then need not trace at
-  /// once: it finds before it traces).
-  bool predictsSpaceFirst() const { return spaceFirst_.load(std::memory_order_relaxed); }
+  /// Whether the worker's rule, after its latest row, finds before it traces (StressRule::findsFirst): the
+  /// sweep then need not trace at once.
+  bool predictsFindsFirst() const { return findsFirst_.load(std::memory_order_relaxed); }
 
   /// The sweep's thread, once the elimination is done: finds rows from the back with @p helper until it meets
   /// the worker, then waits for the worker to finish.
@@ -106,7 +106,7 @@ class FindsAhead {
       if (!slot.status.compare_exchange_strong(expected, kBack))
         break;  // the worker has it, and everything before it
       const LocalStressFinder::State guess = latest();
-      if (guess.inSpaceFirst || !slot.traced)
+      if (guess.inSpaceFirst || !slot.traced || predictsFindsFirst())
         findInto(helper, slot, guess, 0);
       slot.status.store(kDone, std::memory_order_release);
     }
@@ -201,7 +201,7 @@ class FindsAhead {
         std::lock_guard<std::mutex> lock(stateMutex_);
         latest_ = finder.state();
       }
-      spaceFirst_.store(finder.inSpaceFirst(), std::memory_order_relaxed);
+      findsFirst_.store(rule.findsFirst(finder), std::memory_order_relaxed);
       slot.status.store(kDone, std::memory_order_release);
       doneFront_.fetch_add(1, std::memory_order_release);
     }
@@ -212,7 +212,7 @@ class FindsAhead {
   std::unique_ptr<std::unique_ptr<Slot[]>[]> chunks_;
   std::atomic<size_t> published_{0};
   std::atomic<bool> stop_{false};
-  std::atomic<bool> spaceFirst_{false};
+  std::atomic<bool> findsFirst_{false};
   std::atomic<size_t> limitHint_{kTraceLimit};
   std::atomic<size_t> doneFront_{0};
   std::atomic<bool> finished_{false};

@@ -160,7 +160,7 @@ std::optional<SelfStressBasis> sweepBasis(const Mechanism& mechanism, const Coor
         ahead.emplace(LocalStressFinder::Inputs{mechanism, model, J, order, position, tolerance},
                       static_cast<size_t>(m));
       PassedRow row{r, elimination.rank(), 0, std::nullopt};
-      if (!ahead->predictsSpaceFirst()) {
+      if (!ahead->predictsFindsFirst()) {
         row.limit = ahead->traceLimitHint();
         row.trace = elimination.traceDependency(r, elimination.multipliers(), row.limit);
       }

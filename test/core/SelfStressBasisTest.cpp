@@ -19,6 +19,7 @@
 // A private header of the core: its one test is here, beside the reductions that use it.
 #include "../../src/core/SideTask.hpp"
 #include "../../src/core/StressMatrix.hpp"
+#include "../../src/core/StressRule.hpp"
 
 using namespace mobility_analysis;
 
@@ -358,6 +359,8 @@ TEST(SelfStressBasis, FindsMadeAheadGiveTheOneThreadBasisToTheBit) {
   const std::vector<std::pair<std::string, MechanismDescription>> models = {
       {"grid 60 x 60", makeParallelogramGrid(60, 60)},
       {"braced 32 x 32", makeBarLattice(32, 32, true)},
+      // From 36 x 36 cells the rule finds some rows first that it used to trace (StressRule's futile traces).
+      {"braced 36 x 36", makeBarLattice(36, 36, true)},
       {"net 1000", makeRingPantographNet(1000, 60.0)}};
   for (const auto& [name, description] : models) {
     SCOPED_TRACE(name);
@@ -373,6 +376,75 @@ TEST(SelfStressBasis, FindsMadeAheadGiveTheOneThreadBasisToTheBit) {
     EXPECT_TRUE(one.stresses == two.stresses);
     EXPECT_EQ(one.smallestKeptPivot, two.smallestKeptPivot);
   }
+}
+
+TEST(SelfStressBasis, TheRuleFindsFirstOnceTracesKeepRunningPastTheirLimit) {
+  // The sweep's rule for a dependent row (StressRule), with stand-ins for the local find and the traces: a
+  // trace that runs past its limit costs its limit's pivots and is dropped for the find, so after
+  // kFutileTraces such rows in a row the find goes first, until a find fails.
+  const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath("four_bar.urdf")), AnalysisMode::Planar);
+  const EliminationOrder order = computeSweepOrder(m.mechanism, m.assembled.model);
+  std::vector<int> position(m.J.rows());
+  for (size_t i = 0; i < order.rows.size(); ++i)
+    position[order.rows[i]] = static_cast<int>(i);
+  const core_detail::LocalStressFinder finder(m.mechanism, m.assembled.model, m.J, order, position,
+                                              tolerances::kRank);
+  ASSERT_FALSE(finder.inSpaceFirst());
+  const SelfStress local = {{0, 1.0}, {3, -0.5}}, traced = {{1, 1.0}, {2, 0.25}};
+  bool findSucceeds = true, traceSucceeds = false;
+  int finds = 0, traces = 0, locallyResolved = 0;
+  auto find = [&]() -> std::optional<SelfStress> {
+    ++finds;
+    return findSucceeds ? std::optional<SelfStress>(local) : std::nullopt;
+  };
+  auto cappedTrace = [&](size_t) -> std::optional<SelfStress> {
+    ++traces;
+    return traceSucceeds ? std::optional<SelfStress>(traced) : std::nullopt;
+  };
+  auto fullTrace = [&] { return traced; };
+  core_detail::StressRule rule;
+  auto resolve = [&] { return rule.resolve(finder, find, cappedTrace, fullTrace, locallyResolved); };
+  const int k = core_detail::kFutileTraces;
+  for (int row = 0; row < k; ++row) {
+    EXPECT_FALSE(rule.findsFirst(finder)) << row;
+    EXPECT_EQ(resolve(), local);
+  }
+  EXPECT_EQ(traces, k);  // each row traced, then found
+  EXPECT_EQ(finds, k);
+  EXPECT_TRUE(rule.findsFirst(finder));
+  for (int row = 0; row < 10; ++row)
+    EXPECT_EQ(resolve(), local);
+  EXPECT_EQ(traces, k);  // found, not traced
+  EXPECT_EQ(finds, k + 10);
+  // A find that fails: the trace decides, and a trace that succeeds puts it first again.
+  findSucceeds = false;
+  traceSucceeds = true;
+  EXPECT_EQ(resolve(), traced);
+  EXPECT_EQ(traces, k + 1);
+  EXPECT_FALSE(rule.findsFirst(finder));
+  findSucceeds = true;
+  EXPECT_EQ(resolve(), traced);
+  EXPECT_EQ(finds, k + 11);  // traced first, no find
+  EXPECT_EQ(locallyResolved, k + 10);
+  // Traces failing again count afresh from zero; a failing find also stops the count.
+  traceSucceeds = false;
+  for (int row = 0; row < k - 1; ++row)
+    resolve();
+  EXPECT_FALSE(rule.findsFirst(finder));
+  findSucceeds = false;
+  resolve();  // trace fails, find fails: the full trace
+  findSucceeds = true;
+  resolve();
+  EXPECT_FALSE(rule.findsFirst(finder));
+}
+
+TEST(SelfStressBasis, BracedLatticeWhereTheRuleFindsFirstGivesTheContractOrderAnswer) {
+  // 36 x 36 cells: past the futile traces some rows are found first (the basis differs from the traced one),
+  // and it must still be a basis with the contract-order elimination's answer. Closed form: 2RC - R - C + 1.
+  const ModelAtTreePose m = assembleAtTreePose(generated(makeBarLattice(36, 36, true)), AnalysisMode::Planar);
+  checkModel(m, "braced 36 x 36", false);
+  const SelfStressBasis basis = computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
+  EXPECT_EQ(static_cast<int>(basis.stresses.size()), 2 * 36 * 36 - 36 - 36 + 1);
 }
 
 TEST(StressMatrix, EqualsTheTripletMatrixEntryForEntry) {
