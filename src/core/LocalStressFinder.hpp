@@ -16,6 +16,7 @@
 
 #include "EquationGraph.hpp"
 #include "EquationPlaces.hpp"
+#include "IntSorter.hpp"
 #include "LocalMemo.hpp"
 #include "LocalRows.hpp"
 
@@ -249,10 +250,10 @@ class LocalStressFinder {
 
   /// @p rows in sweep order. Their positions are sorted and read back through the order (every row is in it
   /// once): the same order as sorting the rows by position, without the indirection in every comparison.
-  void sortBySweep(std::vector<int>& rows) const {
+  void sortBySweep(std::vector<int>& rows) {
     for (int& r : rows)
       r = position_[r];
-    std::sort(rows.begin(), rows.end());
+    sorter_.sort(rows);
     for (int& r : rows)
       r = order_.rows[static_cast<size_t>(r)];
   }
@@ -277,7 +278,7 @@ class LocalStressFinder {
     if (!columnOfPriority_.empty()) {
       for (int& c : columns)
         c = order_.columnPriority[c];
-      std::sort(columns.begin(), columns.end());
+      sorter_.sort(columns);
       for (int& c : columns)
         c = columnOfPriority_[static_cast<size_t>(c)];
     } else {
@@ -354,6 +355,7 @@ class LocalStressFinder {
   // Kept from call to call (a braced lattice asks for one ball per redundant row): no allocation once warm.
   std::vector<int> ballRows_, joints_, columns_;
   std::vector<int> columnOfPriority_;  ///< Inverse of order_.columnPriority where that is a permutation.
+  IntSorter sorter_;                   ///< The balls' rows by position and columns by priority.
   bool inverseTried_ = false;
   SparseJacobian local_;
   SparseElimination localElimination_;       ///< Reset for each ball (its pools keep their capacity).

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numeric>
 #include <cstdio>
 #include <random>
 #include <set>
@@ -17,6 +19,7 @@
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
 #include "mobility_analysis/generators/ScalingFamilies.hpp"
 // A private header of the core: its one test is here, beside the reductions that use it.
+#include "../../src/core/IntSorter.hpp"
 #include "../../src/core/SideTask.hpp"
 #include "../../src/core/StressMatrix.hpp"
 #include "../../src/core/StressRule.hpp"
@@ -445,6 +448,52 @@ TEST(SelfStressBasis, BracedLatticeWhereTheRuleFindsFirstGivesTheContractOrderAn
   checkModel(m, "braced 36 x 36", false);
   const SelfStressBasis basis = computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
   EXPECT_EQ(static_cast<int>(basis.stresses.size()), 2 * 36 * 36 - 36 - 36 + 1);
+}
+
+TEST(IntSorter, SortsAsStdSortDoes) {
+  // The bitmap path (distinct values in a narrow span, as a ball's rows and columns are) and every case it
+  // leaves to std::sort: short lists, wide spans, repeated values, negative values, the extremes of int.
+  std::mt19937 rng(5);
+  core_detail::IntSorter sorter;
+  auto check = [&](std::vector<int> values, const std::string& what) {
+    std::vector<int> expected = values;
+    std::sort(expected.begin(), expected.end());
+    sorter.sort(values);
+    EXPECT_EQ(values, expected) << what;
+  };
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = std::uniform_int_distribution<int>(0, 400)(rng);
+    const int base = std::uniform_int_distribution<int>(-1000, 900000)(rng);
+    const int span = std::uniform_int_distribution<int>(1, 80)(rng) * std::max(n, 1);
+    std::set<int> distinct;
+    std::uniform_int_distribution<int> value(base, base + span);
+    while (static_cast<int>(distinct.size()) < std::min(n, span + 1))
+      distinct.insert(value(rng));
+    std::vector<int> values(distinct.begin(), distinct.end());
+    std::shuffle(values.begin(), values.end(), rng);
+    check(values, "distinct, trial " + std::to_string(trial));
+    if (!values.empty()) {
+      values.push_back(values[values.size() / 2]);  // one value twice
+      std::shuffle(values.begin(), values.end(), rng);
+      check(values, "repeated, trial " + std::to_string(trial));
+    }
+  }
+  std::vector<int> extremes = {std::numeric_limits<int>::max(), std::numeric_limits<int>::min(), 0};
+  for (int i = 0; i < 60; ++i)
+    extremes.push_back(i * 7 - 100);
+  check(extremes, "extremes");
+  // The bitmap is left all zero for the next list: one value in each of 100 words, a short list with a value
+  // twice (given back to std::sort after the marking), then values beside the first list's in every word.
+  std::vector<int> spread, repeated(40), beside = {0};
+  for (int k = 0; k < 100; ++k) {
+    spread.push_back(64 * (99 - k));
+    beside.push_back(64 * k + 1);
+  }
+  std::iota(repeated.begin(), repeated.end(), 0);
+  repeated.push_back(5);
+  check(spread, "one value a word");
+  check(repeated, "a value twice");
+  check(beside, "beside the first list's values");
 }
 
 TEST(StressMatrix, EqualsTheTripletMatrixEntryForEntry) {
