@@ -20,6 +20,7 @@
 #include "mobility_analysis/generators/ScalingFamilies.hpp"
 // A private header of the core: its one test is here, beside the reductions that use it.
 #include "../../src/core/IntSorter.hpp"
+#include "../../src/core/LocalMemo.hpp"
 #include "../../src/core/SideTask.hpp"
 #include "../../src/core/StressMatrix.hpp"
 #include "../../src/core/StressRule.hpp"
@@ -494,6 +495,53 @@ TEST(IntSorter, SortsAsStdSortDoes) {
   check(spread, "one value a word");
   check(repeated, "a value twice");
   check(beside, "beside the first list's values");
+}
+
+TEST(LocalMemo, AKeyIsItsInputsBitForBit) {
+  // The local eliminations' memo finds a result only under the same inputs to the bit. Keys are built in a
+  // buffer kept from key to key: a longer key of other words is built before each, so a padding word (after
+  // an odd count of ints) left unwritten would differ from the stored key's.
+  core_detail::LocalMemo<int> memo;
+  uint64_t filler = 0x0123456789abcdefull;
+  auto dirty = [&] {
+    memo.clearKey();
+    filler = filler * 6364136223846793005ull + 1442695040888963407ull;
+    for (int i = 0; i < 200; ++i)
+      memo.appendKey(filler + static_cast<uint64_t>(i));
+    EXPECT_EQ(memo.find(), nullptr);
+  };
+  std::vector<Eigen::Triplet<double>> entries = {{0, 0, 1.5}, {1, 2, -0.25}};  // 3 row starts + 2 indices
+  SparseJacobian local(2, 3);
+  local.setFromTriplets(entries.begin(), entries.end());
+  local.makeCompressed();
+  const int odd[3] = {4, 5, 6};
+  auto build = [&](double value, int last) {
+    memo.clearKey();
+    memo.appendKey(local);
+    const int ints[3] = {odd[0], odd[1], last};
+    memo.appendKey(ints, 3);
+    memo.appendKey(value);
+    memo.appendKey(uint64_t{7});
+  };
+  dirty();
+  build(0.5, 6);
+  ASSERT_EQ(memo.find(), nullptr);
+  memo.insert(42, sizeof(int));
+  dirty();
+  build(0.5, 6);
+  const int* found = memo.find();
+  ASSERT_NE(found, nullptr);
+  EXPECT_EQ(*found, 42);
+  dirty();
+  build(std::nextafter(0.5, 1.0), 6);  // one bit of a value
+  EXPECT_EQ(memo.find(), nullptr);
+  dirty();
+  build(0.5, 7);  // one int
+  EXPECT_EQ(memo.find(), nullptr);
+  local.coeffRef(1, 2) = -0.125;  // one entry of the matrix
+  dirty();
+  build(0.5, 6);
+  EXPECT_EQ(memo.find(), nullptr);
 }
 
 TEST(StressMatrix, EqualsTheTripletMatrixEntryForEntry) {
