@@ -32,8 +32,12 @@ struct Share {
 /// Sums the shares of each key, in key order; shares of one key are added in the order given (a stable sort),
 /// so the sums are the same to the last bit whatever the container.
 std::vector<Share> sumByKey(std::vector<Share>& shares) {
-  std::stable_sort(shares.begin(), shares.end(),
-                   [](const Share& a, const Share& b) { return a.key < b.key; });
+  auto byKey = [](const Share& a, const Share& b) { return a.key < b.key; };
+  // Shares come in equation order, in which an element's equations are mostly together and the elements in
+  // order (a braced lattice's prestress: 0.63 10^6 shares of 200 x 200 cells, already sorted, 0.02 s of
+  // stable sort): then the sort would keep them.
+  if (!std::is_sorted(shares.begin(), shares.end(), byKey))
+    std::stable_sort(shares.begin(), shares.end(), byKey);
   std::vector<Share> sums;
   for (const Share& share : shares) {
     if (sums.empty() || sums.back().key != share.key)
