@@ -247,7 +247,7 @@ class Patches {
   std::vector<char> jointTaken_;
   std::vector<int> columnMap_;
   core_detail::IntSorter sorter_;  ///< A patch's rows and columns.
-  SparseJacobian local_;  ///< The patch's rows, storage kept from patch to patch.
+  SparseJacobian local_;           ///< The patch's rows, storage kept from patch to patch.
   // A patch's key is its whole matrix (about 130 kB at radius 5): the 200 x 200 braced lattice's 4 394
   // patches have 1 127 distinct ones, 138 MB, of which the default budget held 550.
   core_detail::LocalMemo<PatchOutcome> memo_{size_t{160} << 20};

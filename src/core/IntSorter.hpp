@@ -14,8 +14,8 @@ namespace core_detail {
 /**
  * Sorts lists of ints in increasing order. Where the values span at most kSpanPerValue times as many integers
  * as there are values, each is marked in a bitmap over that span and read back in order; a value met twice,
- * a wider span or a short list is left to std::sort. Ints in increasing order are one list whatever sorts them,
- * so the result is std::sort's to the bit.
+ * a wider span or a short list is left to std::sort. Ints in increasing order are one list whatever sorts
+ * them, so the result is std::sort's to the bit.
  *
  * Why: the sweep sorts each ball's rows by sweep position and its columns by priority, about 190 of each on a
  * braced lattice, and std::sort of them was a fifth of the sweep's instructions (callgrind, 100 x 100 cells,
@@ -63,7 +63,8 @@ class IntSorter {
       uint64_t word = bits_[w];
       bits_[w] = 0;
       while (word != 0) {
-        values[k++] = static_cast<int>(low + static_cast<int64_t>(w * 64 + static_cast<size_t>(__builtin_ctzll(word))));
+        values[k++] =
+            static_cast<int>(low + static_cast<int64_t>(w * 64 + static_cast<size_t>(__builtin_ctzll(word))));
         word &= word - 1;
       }
     }

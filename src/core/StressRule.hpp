@@ -85,8 +85,8 @@ class StressRule {
   int futileFinds_ = 0;
   // Rows in a row whose capped trace ran past its limit and whose find then succeeded. A failed trace costs
   // its limit's pivots and all their multipliers; once they keep failing, the find goes first (its stress is
-  // another local one with the same last row in sweep order, so the stresses stay a basis), until a find fails
-  // or a trace succeeds.
+  // another local one with the same last row in sweep order, so the stresses stay a basis), until a find
+  // fails or a trace succeeds.
   int futileTraces_ = 0;
 };
 

@@ -5,9 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
-#include <cstdio>
 #include <random>
 #include <set>
 
@@ -447,7 +447,8 @@ TEST(SelfStressBasis, BracedLatticeWhereTheRuleFindsFirstGivesTheContractOrderAn
   // and it must still be a basis with the contract-order elimination's answer. Closed form: 2RC - R - C + 1.
   const ModelAtTreePose m = assembleAtTreePose(generated(makeBarLattice(36, 36, true)), AnalysisMode::Planar);
   checkModel(m, "braced 36 x 36", false);
-  const SelfStressBasis basis = computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
+  const SelfStressBasis basis =
+      computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
   EXPECT_EQ(static_cast<int>(basis.stresses.size()), 2 * 36 * 36 - 36 - 36 + 1);
 }
 
