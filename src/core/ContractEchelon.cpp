@@ -7,13 +7,11 @@
 #include "IntSorter.hpp"
 #include "LocalMemo.hpp"
 #include "LocalRows.hpp"
+#include "StressScaling.hpp"
 
 namespace mobility_analysis {
 
 namespace {
-
-/// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
-constexpr double kStressNoise = 1e-10;
 
 /// A patch stops growing before it holds more equations than this.
 constexpr size_t kPatchLimit = 3000;
@@ -47,15 +45,7 @@ bool isFirm(const SelfStress& stress) {
 void normalise(SelfStress& stress) {
   if (!std::is_sorted(stress.begin(), stress.end()))
     std::sort(stress.begin(), stress.end());
-  double largest = 0.0;
-  for (const auto& entry : stress)
-    largest = std::max(largest, std::abs(entry.second));
-  size_t kept = 0;
-  for (const auto& [row, value] : stress) {
-    if (std::abs(value) > kStressNoise * largest)
-      stress[kept++] = {row, value / largest};
-  }
-  stress.resize(kept);
+  core_detail::scaleToUnitLargest(stress);
 }
 
 /// Balls of links and the contract-order elimination of their equations; workspaces kept across patches.

@@ -12,6 +12,7 @@
 #include "SideTask.hpp"
 #include "StressMatrix.hpp"
 #include "StressRule.hpp"
+#include "StressScaling.hpp"
 
 namespace mobility_analysis {
 
@@ -33,9 +34,6 @@ constexpr size_t kFillFloor = 1000000;
 constexpr size_t kEchelonFillFactor = 2;
 constexpr size_t kEchelonRunningFactor = 8;
 constexpr size_t kEchelonFillFloor = 100000;
-
-/// Stress coefficients below this fraction of the stress's largest are rounding noise [-].
-constexpr double kStressNoise = 1e-10;
 
 /// When an elimination gives up: past a fixed number of stored entries, or past a multiple of the entries of
 /// the rows it has taken so far plus a floor (either 0: not that limit; both: never).
@@ -319,19 +317,8 @@ SelfStressBasis sweepSelfStressBasis(const Mechanism& mechanism, const Coordinat
   }
   SelfStressBasis basis = std::move(*found);
 
-  // Each stress scaled to unit largest coefficient, rounding noise dropped.
-  for (SelfStress& stress : basis.stresses) {
-    double largest = 0.0;
-    for (const auto& entry : stress)
-      largest = std::max(largest, std::abs(entry.second));
-    SelfStress kept;
-    kept.reserve(stress.size());
-    for (const auto& [row, value] : stress) {
-      if (std::abs(value) > kStressNoise * largest)
-        kept.emplace_back(row, value / largest);
-    }
-    stress = std::move(kept);
-  }
+  for (SelfStress& stress : basis.stresses)
+    core_detail::scaleToUnitLargest(stress);
 
   return basis;
 }
