@@ -44,4 +44,15 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
                                              AnalysisMode mode, const JointPositions& driven = {},
                                              bool sideThread = false);
 
+/**
+ * @brief assembleMechanism from the written pose (every tree joint at 0: computeTreePoses with no values),
+ *        nothing driven.
+ *
+ * Where the loops close there already (a tree, a lattice written closed), nothing moves: the poses are the
+ * written pose's as computed, and every revolute, continuous and prismatic tree joint's value is exactly 0
+ * (writtenJointPositions), not read back off the poses, which gives rounding (-5.6e-17 rad).
+ */
+Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, AnalysisMode mode,
+                                             bool sideThread = false);
+
 }  // namespace mobility_analysis

@@ -22,18 +22,27 @@ LinkPoses computeTreePoses(const Mechanism& mechanism, const JointPositions& pos
  *        @p poses, read from the relative pose of its two links.
  *
  * Angles are in (-pi, pi], or the representative nearest @p reference's value where it names the joint (so a
- * continuous joint followed through several turns keeps counting). Fixed, floating and other multi-freedom tree
- * joints have no single value and are left out.
+ * continuous joint followed through several turns keeps counting). Fixed, floating and other multi-freedom
+ * tree joints have no single value and are left out.
  * @return Joint values [rad] or [m] by name.
  */
 JointPositions computeJointPositions(const Mechanism& mechanism, const LinkPoses& poses,
                                      const JointPositions& reference = {});
 
 /**
+ * @brief The values computeJointPositions reads off the written pose (computeTreePoses with no values), as
+ *        they were written: every revolute, continuous and prismatic tree joint at exactly 0.
+ *
+ * Read back off the poses instead they come out as rounding (a PUMA 560's joint2 at -5.6e-17 rad).
+ */
+JointPositions writtenJointPositions(const Mechanism& mechanism);
+
+/**
  * @brief How far @p joint is from holding at @p poses: the distance between its two joint-frame origins
  *        that the joint type forbids [m] plus the angle between axes it forbids [rad] times @p lengthScale.
  */
-double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int joint, double lengthScale);
+double computeJointResidual(const Mechanism& mechanism, const LinkPoses& poses, int joint,
+                            double lengthScale);
 
 /**
  * @brief A characteristic length of the mechanism [m]: the RMS distance of all joint-frame origins (at

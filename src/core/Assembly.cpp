@@ -22,17 +22,20 @@ double maxAbs(const Eigen::VectorXd& v) {
   return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff();
 }
 
-}  // namespace
-
-Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const LinkPoses& startPoses,
-                                             AnalysisMode mode, const JointPositions& driven,
-                                             bool sideThread) {
+/**
+ * assembleMechanism from @p startPoses; @p writtenPoses, when given, is @p startPoses itself and says they
+ * are the written pose's (computeTreePoses with no values), which this call may keep (move from).
+ */
+Result<AssembledMechanism> assembleFrom(const Mechanism& mechanism, const LinkPoses& startPoses,
+                                        LinkPoses* writtenPoses, AnalysisMode mode,
+                                        const JointPositions& driven, bool sideThread) {
   const double lc = computeCharacteristicLength(mechanism, startPoses);
   AssembledMechanism assembled;
   const ClosureLayout layout = makeClosureLayout(mechanism, startPoses, lc);
   const bool nothingToClose = layout.numResiduals == 0;
   // Without driven joints their values are read off the closed poses (a fifth of the model's building on a
   // 10^5-link chain), which nothing writes once the model is being built: on a large model, beside it.
+  bool asWritten = false;  // nothing moved from the written pose: its joint values are the written ones
   const bool positionsBeside =
       driven.empty() && sideThread &&
       static_cast<long>(kEquationsPerLink * mechanism.links.size()) >= core_detail::kSecondThreadEquations;
@@ -41,8 +44,13 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
     // residual, and stops there when the loops close already: with no residual rows (a tree with no
     // loop-closing connection, coupling or multi-freedom tree joint of its own equations) or at a written
     // pose that closes (a lattice of bars). Those poses are taken directly then, and no configuration is
-    // made.
-    LinkPoses poses = reposeTree(mechanism, layout, startPoses);
+    // made. The written pose's are the tree's own already (computeTreePoses): re-posed they would come back
+    // the same but for rounding, and the joint values read off them would be rounding too (a PUMA 560's
+    // joint2 at -5.6e-17 rad). Where it closes, nothing moved: its poses are kept, its values are the written
+    // ones, exactly (writtenJointPositions), and a 10^5-link chain skips both passes.
+    LinkPoses poses =
+        writtenPoses != nullptr ? std::move(*writtenPoses) : reposeTree(mechanism, layout, startPoses);
+    const LinkPoses& start = writtenPoses != nullptr ? poses : startPoses;
     bool closed = true;
     if (!nothingToClose) {
       int numColumns = 0;
@@ -53,7 +61,7 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
       closed = maxAbs(residual) <= layout.target;
       if (!closed) {
         Result<ClosedConfiguration> reached = closeLoops(
-            mechanism, layout, configurationFromPoses(mechanism, layout, startPoses), columns, numColumns);
+            mechanism, layout, configurationFromPoses(mechanism, layout, start), columns, numColumns);
         if (!isOk(reached))
           return diagnosticOf(reached);
         ClosedConfiguration& loops = std::get<ClosedConfiguration>(reached);
@@ -63,8 +71,10 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
       }
     }
     assembled.poses = std::move(poses);
+    asWritten = writtenPoses != nullptr && closed;
     if (!positionsBeside)
-      assembled.positions = computeJointPositions(mechanism, assembled.poses);
+      assembled.positions =
+          asWritten ? writtenJointPositions(mechanism) : computeJointPositions(mechanism, assembled.poses);
   } else {
     const TreeConfiguration start = configurationFromPoses(mechanism, layout, startPoses);
     int numColumns = 0;
@@ -90,7 +100,9 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
 
   std::optional<core_detail::SideTask<JointPositions>> positions;
   if (positionsBeside)
-    positions.emplace(true, [&] { return computeJointPositions(mechanism, assembled.poses); });
+    positions.emplace(true, [&] {
+      return asWritten ? writtenJointPositions(mechanism) : computeJointPositions(mechanism, assembled.poses);
+    });
   Result<CoordinateModel> model = buildCoordinateModel(mechanism, assembled.poses, mode, lc);
   if (!isOk(model))
     return diagnosticOf(model);
@@ -123,6 +135,19 @@ Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const L
                           mechanism.joints[worst].name, what);
   }
   return assembled;
+}
+
+}  // namespace
+
+Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, const LinkPoses& startPoses,
+                                             AnalysisMode mode, const JointPositions& driven,
+                                             bool sideThread) {
+  return assembleFrom(mechanism, startPoses, nullptr, mode, driven, sideThread);
+}
+
+Result<AssembledMechanism> assembleMechanism(const Mechanism& mechanism, AnalysisMode mode, bool sideThread) {
+  LinkPoses written = computeTreePoses(mechanism, {});
+  return assembleFrom(mechanism, written, &written, mode, {}, sideThread);
 }
 
 }  // namespace mobility_analysis

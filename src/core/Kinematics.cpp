@@ -64,6 +64,13 @@ std::vector<NameKey> sortedByName(const std::vector<std::pair<std::string_view, 
   return keyed;
 }
 
+/// A revolute, continuous or prismatic tree joint: one value, read off the poses by computeJointPositions.
+bool hasSingleValue(const Joint& joint) {
+  return joint.kind == ConnectionKind::TreeJoint &&
+         (joint.type == JointType::Revolute || joint.type == JointType::Continuous ||
+          joint.type == JointType::Prismatic);
+}
+
 /**
  * @brief The map of @p values (name, value), the last value of a name kept, as operator[] in their order
  * gave.
@@ -121,9 +128,9 @@ JointPositions computeJointPositions(const Mechanism& mechanism, const LinkPoses
   std::vector<std::pair<std::string_view, double>> values;
   values.reserve(mechanism.joints.size());
   for (const Joint& joint : mechanism.joints) {
-    const bool turns = joint.type == JointType::Revolute || joint.type == JointType::Continuous;
-    if (joint.kind != ConnectionKind::TreeJoint || !(turns || joint.type == JointType::Prismatic))
+    if (!hasSingleValue(joint))
       continue;
+    const bool turns = joint.type == JointType::Revolute || joint.type == JointType::Continuous;
     // The child frame is the joint frame moved by motion(value): T = (T_parent * origin)^-1 * T_child.
     const Eigen::Isometry3d motion = (poses[joint.link1] * joint.frame1).inverse() * poses[joint.link2];
     double value = 0.0;
@@ -138,6 +145,16 @@ JointPositions computeJointPositions(const Mechanism& mechanism, const LinkPoses
       value = joint.axis.dot(motion.translation());
     }
     values.emplace_back(joint.name, value);
+  }
+  return toJointPositions(values);
+}
+
+JointPositions writtenJointPositions(const Mechanism& mechanism) {
+  std::vector<std::pair<std::string_view, double>> values;
+  values.reserve(mechanism.joints.size());
+  for (const Joint& joint : mechanism.joints) {
+    if (hasSingleValue(joint))
+      values.emplace_back(joint.name, 0.0);
   }
   return toJointPositions(values);
 }

@@ -44,15 +44,24 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   if (!options.lockActiveCables || !hasActive)
     return analyzeAssembled(mechanism, options, {});
   // Lock at the pose the free mechanism assembles to, then analyse the locked copy from there.
-  Result<AssembledMechanism> free = assembleMechanism(
-      mechanism, options.startPoses ? *options.startPoses : computeTreePoses(mechanism, options.positions),
-      options.mode);
+  Result<AssembledMechanism> free =
+      options.startPoses || !options.positions.empty()
+          ? assembleMechanism(
+                mechanism,
+                options.startPoses ? *options.startPoses : computeTreePoses(mechanism, options.positions),
+                options.mode)
+          : assembleMechanism(mechanism, options.mode);
   if (!isOk(free))
     return diagnosticOf(free);
   std::vector<bool> locked;
   const Mechanism lockedMechanism = lockActiveCables(mechanism, valueOf(free).poses, locked);
   AnalysisOptions lockedOptions = options;
-  lockedOptions.startPoses = valueOf(free).poses;
+  // From the free pose; where that is the written pose, closed there without moving, the locked copy (the
+  // same tree) starts from its own written pose, the same poses, and keeps its exact joint values.
+  const bool atWrittenPose =
+      !options.startPoses && options.positions.empty() && valueOf(free).iterations == 0;
+  if (!atWrittenPose)
+    lockedOptions.startPoses = valueOf(free).poses;
   return analyzeAssembled(lockedMechanism, lockedOptions, locked);
 }
 
@@ -94,8 +103,11 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   // Driven positions are held exactly and reached by continuation from the start (the previous state, else
   // the written pose), so the mechanism stays in the start's assembly mode (motion/DrivenAssembly.hpp).
   Result<AssembledMechanism> assembled =
-      assembleMechanism(mechanism, options.startPoses ? *options.startPoses : computeTreePoses(mechanism, {}),
-                        options.mode, options.positions, options.sideThreads);
+      options.startPoses || !options.positions.empty()
+          ? assembleMechanism(mechanism,
+                              options.startPoses ? *options.startPoses : computeTreePoses(mechanism, {}),
+                              options.mode, options.positions, options.sideThreads)
+          : assembleMechanism(mechanism, options.mode, options.sideThreads);
   if (!isOk(assembled))
     return diagnosticOf(assembled);
   MobilityAnalysis analysis;

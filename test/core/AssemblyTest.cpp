@@ -1,7 +1,10 @@
 #include "mobility_analysis/Assembly.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -182,6 +185,66 @@ TEST(Assembly, SideThreadGivesTheSameAssembly) {
   EXPECT_EQ(valueOf(alone).positions.size(), static_cast<size_t>(links));
   EXPECT_TRUE(valueOf(alone).q == valueOf(beside).q);
   EXPECT_EQ(valueOf(alone).model.numConstraints(), valueOf(beside).model.numConstraints());
+}
+
+// At the written pose, where the loops close already, nothing moves: the poses are the written ones bit for
+// bit and every joint value is the written 0, not the rounding read back off the poses (the PUMA 560's joint2
+// read -5.6e-17 rad, the Bennett linkage's joints +-1e-16). Read off, the same joints come out within 1e-12
+// of 0 (the independent check); the 12 000-link chain is above the side thread's threshold, with and without
+// it.
+TEST(Assembly, AtTheWrittenPoseNothingMovesAndEveryJointIsExactlyAtItsWrittenZero) {
+  std::vector<std::pair<std::string, Mechanism>> models{{"puma560", loadOrFail(urdfPath("puma560.urdf"))},
+                                                        {"bennett", loadOrFail(urdfPath("bennett.urdf"))}};
+  const Result<Mechanism> chain = loadMechanismFromString(straightChainUrdf(12000), "long_chain.urdf");
+  ASSERT_TRUE(isOk(chain)) << diagnosticOf(chain).toString();
+  models.emplace_back("chain", valueOf(chain));
+  for (const auto& [name, mechanism] : models) {
+    const LinkPoses written = computeTreePoses(mechanism, {});
+    for (const bool sideThread : {false, true}) {
+      SCOPED_TRACE(name + (sideThread ? ", side thread" : ""));
+      const Result<AssembledMechanism> assembled =
+          assembleMechanism(mechanism, AnalysisMode::Auto, sideThread);
+      ASSERT_TRUE(isOk(assembled)) << diagnosticOf(assembled).toString();
+      const AssembledMechanism& a = valueOf(assembled);
+      EXPECT_EQ(a.iterations, 0);
+      ASSERT_EQ(a.poses.size(), written.size());
+      for (size_t l = 0; l < written.size(); ++l)
+        ASSERT_TRUE(a.poses[l].matrix() == written[l].matrix()) << mechanism.links[l].name;
+      const JointPositions readOff = computeJointPositions(mechanism, a.poses);
+      ASSERT_EQ(a.positions.size(), readOff.size());
+      ASSERT_FALSE(a.positions.empty());
+      for (auto p = a.positions.begin(), r = readOff.begin(); p != a.positions.end(); ++p, ++r) {
+        EXPECT_EQ(p->first, r->first);
+        EXPECT_EQ(p->second, 0.0) << p->first;
+        EXPECT_NEAR(r->second, 0.0, 1e-12) << r->first;
+      }
+      // The same model as from the written poses given as a start (re-posed): the same counts.
+      const Result<AssembledMechanism> given = assembleMechanism(mechanism, written, AnalysisMode::Auto);
+      ASSERT_TRUE(isOk(given));
+      EXPECT_EQ(a.model.numCoordinates(), valueOf(given).model.numCoordinates());
+      EXPECT_EQ(a.model.numConstraints(), valueOf(given).model.numConstraints());
+      EXPECT_LT((a.q - valueOf(given).q).cwiseAbs().maxCoeff(), 1e-12);
+    }
+  }
+  // The report says so too.
+  const MobilityAnalysis puma = analyzeOrFail(urdfPath("puma560.urdf"), AnalysisMode::Auto);
+  ASSERT_EQ(puma.report.positions.size(), 6u);
+  for (const JointValue& value : puma.report.positions)
+    EXPECT_EQ(value.value, 0.0) << value.name;
+}
+
+// Written open, the loop has to be closed: the joints move, and their values are read off the closed poses.
+TEST(Assembly, FromAWrittenPoseThatDoesNotCloseTheValuesAreReadOffTheClosedPoses) {
+  const Mechanism mechanism = loadOrFail(fixturePath("four_bar_open.urdf"));
+  const Result<AssembledMechanism> assembled = assembleMechanism(mechanism, AnalysisMode::Planar);
+  ASSERT_TRUE(isOk(assembled)) << diagnosticOf(assembled).toString();
+  const AssembledMechanism& a = valueOf(assembled);
+  EXPECT_GT(a.iterations, 0);
+  EXPECT_EQ(a.positions, computeJointPositions(mechanism, a.poses));
+  double largest = 0.0;
+  for (const auto& [name, value] : a.positions)
+    largest = std::max(largest, std::abs(value));
+  EXPECT_GT(largest, 1e-3);
 }
 
 TEST(Assembly, aMechanismFarFromTheOriginOfItsModelClosesAndReportsAsNearIt) {

@@ -193,6 +193,24 @@ TEST(SelfStressReport, PrestressFromTheLinearProgramIsASelfStressWithTautCablesI
   EXPECT_FALSE(findCablePrestress(stresses2, J2.rows(), rows2).feasible);
 }
 
+// Locked where the free mast closes at its written pose, it is analysed from that pose, where nothing moved:
+// its joint values are the written 0 exactly, as the free analysis reports them (read back off the free
+// poses they were +-1e-47 rad).
+TEST(SelfStressReport, LockedAtTheWrittenPoseTheJointsAreAtTheirWrittenZero) {
+  const Mechanism mechanism = loadOrFail(urdfPath("sle_deployable_deployed.urdf"));
+  const MobilityReport free = analyze(mechanism).report;
+  const MobilityReport locked = analyze(mechanism, true).report;
+  ASSERT_FALSE(locked.positions.empty());
+  ASSERT_EQ(locked.positions.size(), free.positions.size());
+  for (size_t j = 0; j < locked.positions.size(); ++j) {
+    EXPECT_EQ(locked.positions[j].name, free.positions[j].name);
+    EXPECT_EQ(locked.positions[j].value, 0.0) << locked.positions[j].name;
+    EXPECT_EQ(free.positions[j].value, 0.0) << free.positions[j].name;
+  }
+  EXPECT_EQ(locked.assembly.iterations, 0);
+  EXPECT_EQ(locked.selfStress.count, free.selfStress.count + 1);  // the locked base cable closes one more
+}
+
 TEST(SelfStressReport, RingPantographMatchesTheMast) {
   const MobilityReport folded = analyzeFile("ring_pantograph_folded.urdf").report;
   EXPECT_EQ(folded.dof, 1);
