@@ -3,10 +3,14 @@
 #include <limits>
 #include <regex>
 #include <sstream>
+#include <string>
+#include <variant>
 
 #include <gtest/gtest.h>
 
 #include "core/TestModels.hpp"
+#include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
+#include "mobility_analysis/generators/ParametricFamilies.hpp"
 // A private header of the core: toJson with its threshold for the second thread.
 #include "../../src/core/JsonHalves.hpp"
 
@@ -16,9 +20,10 @@ namespace {
 
 /// The JSON without the fields that carry the unit or the file name.
 std::string unitFree(std::string json) {
-  // positions carry rounding noise of the pose (1e-16 rad) and assembly.residual is in metres.
-  for (const char* key : {"robot", "file", "characteristic_length", "closure_residual", "rank_margin",
-                          "positions", "assembly"}) {
+  // assembly.residual is in metres, the closure residuals and the rank margin's are rounding. The positions
+  // stay: at the written pose they are its values exactly, in either unit.
+  for (const char* key :
+       {"robot", "file", "characteristic_length", "closure_residual", "rank_margin", "assembly"}) {
     json = std::regex_replace(json, std::regex(std::string("\\n  \"") + key + "\": [^\\n]*"), "");
   }
   return json;
@@ -65,6 +70,41 @@ TEST(MobilityReport, BennettInMillimetresAndMetresGiveTheSameReport) {
   EXPECT_NEAR(millimetres.characteristicLength / metres.characteristicLength, 1000.0, 1e-6);
   EXPECT_EQ(metres.dof, 1);
   EXPECT_EQ(metres.numRedundant, 3);
+}
+
+// A continuous-bar grid's states hold forces that agree to the last few bits (0.894427191 twice, 1 and
+// 1 - 2^-53): listed in the order of those bits, the same grid written in millimetres listed them in another
+// order than in metres. Forces that agree to the nine digits printed keep the order of their elements.
+TEST(MobilityReport, ParallelogramGridInMillimetresAndMetresGiveTheSameReport) {
+  UrdfWriterOptions noVisuals;
+  noVisuals.visuals = false;
+  const GeneratorResult<std::string> generated = toClosedLoopUrdf(makeParallelogramGrid(3, 4), noVisuals);
+  ASSERT_TRUE(std::holds_alternative<std::string>(generated));
+  const std::string metresText = std::get<std::string>(generated);
+  // Every xyz in millimetres (the grid has no other length).
+  std::string millimetresText;
+  const std::regex xyz("xyz=\"([^\"]*)\"");
+  auto from = metresText.cbegin();
+  for (std::sregex_iterator it(metresText.begin(), metresText.end(), xyz), end; it != end; ++it) {
+    millimetresText.append(from, (*it)[0].first);
+    std::istringstream values((*it)[1].str());
+    std::ostringstream scaled;
+    scaled.precision(17);
+    for (double v; values >> v;)
+      scaled << (scaled.tellp() > 0 ? " " : "") << 1000.0 * v;
+    millimetresText += "xyz=\"" + scaled.str() + "\"";
+    from = (*it)[0].second;
+  }
+  millimetresText.append(from, metresText.cend());
+  ASSERT_EQ(metresText.find("length="), std::string::npos);
+  const Result<Mechanism> metres = loadMechanismFromString(metresText, "grid.urdf");
+  const Result<Mechanism> millimetres = loadMechanismFromString(millimetresText, "grid_mm.urdf");
+  ASSERT_TRUE(isOk(metres) && isOk(millimetres));
+  const MobilityReport m = analyzeOrFail(valueOf(metres), AnalysisMode::Auto).report;
+  const MobilityReport mm = analyzeOrFail(valueOf(millimetres), AnalysisMode::Auto).report;
+  ASSERT_EQ(m.selfStress.count, 17);  // DOF 1 against the planar count R + C + 1 - 2RC = -16
+  EXPECT_EQ(unitFree(toJson(m)), unitFree(toJson(mm)));
+  EXPECT_NEAR(mm.characteristicLength / m.characteristicLength, 1000.0, 1e-6);
 }
 
 TEST(MobilityReport, ElementClassesMarkTheLoopJointRedAndTheLoopOrange) {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -45,6 +47,20 @@ std::vector<Share> sumByKey(std::vector<Share>& shares) {
     sums.back().value += share.value;
   }
   return sums;
+}
+
+/// Low bits of a force's magnitude dropped when forces are ordered: 29 of its 52 mantissa bits stay, about
+/// the nine decimal digits the JSON prints.
+constexpr int kDroppedBits = 23;
+
+/// |@p value| (finite) rounded to the bits that order forces, as an integer that orders as the magnitude: a
+/// positive double's bit pattern does, across powers of two too (1 and 1 - 2^-53 are neighbours there, so
+/// they tie; a quantised mantissa alone would put them a binade apart).
+uint64_t quantisedMagnitude(double value) {
+  const double magnitude = std::abs(value);
+  uint64_t bits = 0;
+  std::memcpy(&bits, &magnitude, sizeof(bits));
+  return (bits + (uint64_t{1} << (kDroppedBits - 1))) >> kDroppedBits;
 }
 
 /// The elements carrying a multiplier vector given as (row, value) pairs, forces relative to the largest.
@@ -97,19 +113,21 @@ std::vector<ElementForce> elementForces(const Mechanism& mechanism, const Coordi
   std::vector<ElementForce> kept;
   if (largest <= 0.0)
     return kept;
-  std::vector<int> order;
+  // Largest first. Forces that agree to about nine digits (as the JSON prints them) tie and keep the order of
+  // their elements, which the rounding of a pose cannot change: ordered by their last bits, the same
+  // parallelogram grid written in millimetres listed its states' elements in another order than in metres.
+  std::vector<std::pair<uint64_t, int>> order;  // (magnitude quantised, force), then sorted
   order.reserve(forces.size());
   for (size_t i = 0; i < forces.size(); ++i) {
     Force& f = forces[i];
     f.value = (f.isSigned ? sign : 1.0) * f.value / largest;
     if (std::abs(f.value) > kSupportFloor)
-      order.push_back(static_cast<int>(i));
+      order.emplace_back(quantisedMagnitude(f.value), static_cast<int>(i));
   }
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    return std::abs(forces[static_cast<size_t>(a)].value) > std::abs(forces[static_cast<size_t>(b)].value);
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
   kept.reserve(order.size());
-  for (int i : order) {
+  for (const auto& [magnitude, i] : order) {
     const Force& f = forces[static_cast<size_t>(i)];
     ElementForce force;
     const auto source = static_cast<EquationSource>(f.key.first);
