@@ -11,6 +11,7 @@
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
+#include "mobility_analysis/generators/ScalingFamilies.hpp"
 // A private header of the core: toJson with its threshold for the second thread.
 #include "../../src/core/JsonHalves.hpp"
 
@@ -72,40 +73,68 @@ TEST(MobilityReport, BennettInMillimetresAndMetresGiveTheSameReport) {
   EXPECT_EQ(metres.numRedundant, 3);
 }
 
-// A continuous-bar grid's states hold forces that agree to the last few bits (0.894427191 twice, 1 and
-// 1 - 2^-53): listed in the order of those bits, the same grid written in millimetres listed them in another
-// order than in metres. Forces that agree to the nine digits printed keep the order of their elements.
-TEST(MobilityReport, ParallelogramGridInMillimetresAndMetresGiveTheSameReport) {
-  UrdfWriterOptions noVisuals;
-  noVisuals.visuals = false;
-  const GeneratorResult<std::string> generated = toClosedLoopUrdf(makeParallelogramGrid(3, 4), noVisuals);
-  ASSERT_TRUE(std::holds_alternative<std::string>(generated));
-  const std::string metresText = std::get<std::string>(generated);
-  // Every xyz in millimetres (the grid has no other length).
-  std::string millimetresText;
-  const std::regex xyz("xyz=\"([^\"]*)\"");
-  auto from = metresText.cbegin();
-  for (std::sregex_iterator it(metresText.begin(), metresText.end(), xyz), end; it != end; ++it) {
-    millimetresText.append(from, (*it)[0].first);
-    std::istringstream values((*it)[1].str());
-    std::ostringstream scaled;
-    scaled.precision(17);
-    for (double v; values >> v;)
-      scaled << (scaled.tellp() > 0 ? " " : "") << 1000.0 * v;
-    millimetresText += "xyz=\"" + scaled.str() + "\"";
-    from = (*it)[0].second;
-  }
-  millimetresText.append(from, metresText.cend());
-  ASSERT_EQ(metresText.find("length="), std::string::npos);
-  const Result<Mechanism> metres = loadMechanismFromString(metresText, "grid.urdf");
-  const Result<Mechanism> millimetres = loadMechanismFromString(millimetresText, "grid_mm.urdf");
-  ASSERT_TRUE(isOk(metres) && isOk(millimetres));
-  const MobilityReport m = analyzeOrFail(valueOf(metres), AnalysisMode::Auto).report;
-  const MobilityReport mm = analyzeOrFail(valueOf(millimetres), AnalysisMode::Auto).report;
-  ASSERT_EQ(m.selfStress.count, 17);  // DOF 1 against the planar count R + C + 1 - 2RC = -16
-  EXPECT_EQ(unitFree(toJson(m)), unitFree(toJson(mm)));
-  EXPECT_NEAR(mm.characteristicLength / m.characteristicLength, 1000.0, 1e-6);
+// The same model in metres, millimetres and kilometres gives the same report but for its units. Each family
+// here broke it through its rounding before: a continuous-bar grid's states hold forces that agree to the
+// last few bits (0.894427191 twice, 1 and 1 - 2^-53), listed in the order of those bits; a truss mast's and a
+// ring pantograph's states hold cables pulling against each other with equal forces, and which was "largest"
+// (tension positive) set the sign of the whole state; a braced lattice's prestress program has many optima,
+// and which vertex Clp reached followed the states' last bits. Now ties to the nine digits printed keep the
+// elements' order, and the program's coefficients are rounded to 2^-40.
+struct ScaledFamily {
+  const char* name;
+  MechanismDescription (*make)();
+  AnalysisMode mode;
+  bool lockActiveCables;
+};
+
+void PrintTo(const ScaledFamily& family, std::ostream* out) {
+  *out << family.name;
 }
+
+class SameReportInAnyUnit : public ::testing::TestWithParam<ScaledFamily> {};
+
+TEST_P(SameReportInAnyUnit, OnlyTheUnitsDiffer) {
+  const ScaledFamily& family = GetParam();
+  auto reportAt = [&](double factor) {
+    MechanismDescription description = family.make();
+    scaleMechanism(description, factor);
+    UrdfWriterOptions noVisuals;
+    noVisuals.visuals = false;
+    const GeneratorResult<std::string> urdf = toClosedLoopUrdf(description, noVisuals);
+    EXPECT_TRUE(std::holds_alternative<std::string>(urdf));
+    const Result<Mechanism> mechanism = loadMechanismFromString(
+        std::holds_alternative<std::string>(urdf) ? std::get<std::string>(urdf) : "", "scaled.urdf");
+    EXPECT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+    AnalysisOptions options;
+    options.mode = family.mode;
+    options.lockActiveCables = family.lockActiveCables;
+    const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+    EXPECT_TRUE(isOk(analysis)) << diagnosticOf(analysis).toString();
+    return valueOf(analysis).report;
+  };
+  const MobilityReport metres = reportAt(1.0);
+  ASSERT_GT(metres.selfStress.count, 0);
+  for (const double factor : {1000.0, 0.001}) {
+    SCOPED_TRACE(factor);
+    const MobilityReport scaled = reportAt(factor);
+    // Cable lengths and distances are in metres.
+    const std::regex cables("\\n  \"cables\": [^\\n]*");
+    EXPECT_EQ(std::regex_replace(unitFree(toJson(metres)), cables, ""),
+              std::regex_replace(unitFree(toJson(scaled)), cables, ""));
+    EXPECT_NEAR(scaled.characteristicLength / metres.characteristicLength, factor, 1e-9 * factor);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Families, SameReportInAnyUnit,
+    ::testing::Values(
+        ScaledFamily{"grid", [] { return makeParallelogramGrid(3, 4); }, AnalysisMode::Auto, false},
+        ScaledFamily{"truss", [] { return makeTrussMast(3); }, AnalysisMode::Spatial, false},
+        ScaledFamily{"pantograph", [] { return makeRingPantograph(4, 60.0); }, AnalysisMode::Auto, false},
+        ScaledFamily{"pantograph_locked", [] { return makeRingPantograph(4, 60.0); }, AnalysisMode::Auto,
+                     true},
+        ScaledFamily{"braced", [] { return makeBarLattice(3, 3, true); }, AnalysisMode::Auto, false}),
+    [](const ::testing::TestParamInfo<ScaledFamily>& info) { return std::string(info.param.name); });
 
 TEST(MobilityReport, ElementClassesMarkTheLoopJointRedAndTheLoopOrange) {
   const MobilityReport report =

@@ -11,6 +11,8 @@
 #include "mobility_analysis/Tolerances.hpp"
 #include "mobility_analysis/analysis/Prestress.hpp"
 #include "mobility_analysis/analysis/SelfStressReport.hpp"
+// A private header of the core: how the report compares forces.
+#include "../../src/core/SignificantBits.hpp"
 
 using namespace mobility_analysis;
 
@@ -209,6 +211,23 @@ TEST(SelfStressReport, LockedAtTheWrittenPoseTheJointsAreAtTheirWrittenZero) {
   }
   EXPECT_EQ(locked.assembly.iterations, 0);
   EXPECT_EQ(locked.selfStress.count, free.selfStress.count + 1);  // the locked base cable closes one more
+}
+
+// What the report compares forces by: neighbours of a power of two round together (1 and 1 - 2^-53, which a
+// rounded mantissa would put a binade apart), magnitudes that differ in the digits kept keep their order, and
+// the grid rounding of the prestress program's coefficients is exact on multiples of its step.
+TEST(SelfStressReport, SignificantBitsRoundNeighboursTogetherAndKeepTheOrder) {
+  using core_detail::roundedMagnitudeBits;
+  using core_detail::roundToGrid;
+  const double justBelowOne = std::nextafter(1.0, 0.0);
+  EXPECT_EQ(roundedMagnitudeBits(1.0, 23), roundedMagnitudeBits(justBelowOne, 23));
+  EXPECT_EQ(roundedMagnitudeBits(-0.894427191, 23), roundedMagnitudeBits(0.894427191 * (1 + 1e-15), 23));
+  EXPECT_LT(roundedMagnitudeBits(0.894427191, 23), roundedMagnitudeBits(0.894427192, 23));
+  EXPECT_LT(roundedMagnitudeBits(0.5, 23), roundedMagnitudeBits(1.0, 23));
+  EXPECT_EQ(roundToGrid(0.75, 40), 0.75);
+  EXPECT_EQ(roundToGrid(-0.3 + 1e-16, 40), roundToGrid(-0.3, 40));
+  EXPECT_NEAR(roundToGrid(0.3, 40), 0.3, std::ldexp(1.0, -41));
+  EXPECT_EQ(roundToGrid(std::ldexp(1.0, -50), 40), 0.0);
 }
 
 TEST(SelfStressReport, RingPantographMatchesTheMast) {

@@ -12,6 +12,7 @@
 
 #include "../LocalMemo.hpp"
 #include "../LocalRows.hpp"
+#include "../SignificantBits.hpp"
 
 namespace mobility_analysis {
 
@@ -36,6 +37,13 @@ constexpr double kLocalNoise = 1e-11;
 /// The sum of local states must be in equilibrium to this (|J^T y| against |J| |y|, both at most 1) [-].
 constexpr double kLocalResidual = 1e-9;
 
+/// The program's coefficients (states at unit largest coefficient) are rounded to multiples of 2^-40 (about
+/// 10^-12) before Clp sees them. Why: its optimum is mostly not unique, and which vertex Clp reaches follows
+/// its pivots, which the rounding of the states decides: the same braced lattice in millimetres and in
+/// metres got different prestress patterns. Rounded, the same model gives the same program, bit for bit, and
+/// the tension floor (10^-9) is far above the change.
+constexpr int kProgramFractionBits = 40;
+
 /// The linear program over the states' weights (see findCablePrestress); cableIndex maps rows to cables.
 CablePrestress solvePrestressProgram(const std::vector<SelfStress>& states, int numConstraints,
                                      const std::vector<int>& cableRows,
@@ -56,7 +64,7 @@ CablePrestress solvePrestressProgram(const std::vector<SelfStress>& states, int 
         continue;
       rowIndices.push_back(it->second);
       columnIndices.push_back(s);
-      elements.push_back(value);
+      elements.push_back(core_detail::roundToGrid(value, kProgramFractionBits));
     }
   }
   for (int c = 0; c < numCables; ++c) {

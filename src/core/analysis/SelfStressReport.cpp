@@ -4,12 +4,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/QR>
 
+#include "../SignificantBits.hpp"
 #include "mobility_analysis/analysis/Prestress.hpp"
 
 namespace mobility_analysis {
@@ -49,18 +49,14 @@ std::vector<Share> sumByKey(std::vector<Share>& shares) {
   return sums;
 }
 
-/// Low bits of a force's magnitude dropped when forces are ordered: 29 of its 52 mantissa bits stay, about
-/// the nine decimal digits the JSON prints.
+/// Low bits of a force's magnitude dropped when forces are ordered or compared: 29 of its 52 mantissa bits
+/// stay, about the nine decimal digits the JSON prints.
 constexpr int kDroppedBits = 23;
 
-/// |@p value| (finite) rounded to the bits that order forces, as an integer that orders as the magnitude: a
-/// positive double's bit pattern does, across powers of two too (1 and 1 - 2^-53 are neighbours there, so
-/// they tie; a quantised mantissa alone would put them a binade apart).
+/// |@p value| to the bits that order forces, as an integer that orders as the magnitude
+/// (SignificantBits.hpp).
 uint64_t quantisedMagnitude(double value) {
-  const double magnitude = std::abs(value);
-  uint64_t bits = 0;
-  std::memcpy(&bits, &magnitude, sizeof(bits));
-  return (bits + (uint64_t{1} << (kDroppedBits - 1))) >> kDroppedBits;
+  return core_detail::roundedMagnitudeBits(value, kDroppedBits);
 }
 
 /// The elements carrying a multiplier vector given as (row, value) pairs, forces relative to the largest.
@@ -103,11 +99,17 @@ std::vector<ElementForce> elementForces(const Mechanism& mechanism, const Coordi
   double largest = 0.0;
   for (const Force& f : forces)
     largest = std::max(largest, std::abs(f.value));
-  // Sign of a state is free: make its largest signed (cable / distance) force a tension.
+  // Sign of a state is free: make its largest signed (cable / distance) force a tension. Of forces that tie
+  // to the digits printed (two cables pulling against each other), the first element's: by the last bits the
+  // sign of the whole state came out differently in millimetres and in metres.
   double largestSigned = 0.0;
+  uint64_t largestQuantised = 0;
   for (const Share& share : signedForce) {
-    if (std::abs(share.value) > std::abs(largestSigned))
+    const uint64_t quantised = quantisedMagnitude(share.value);
+    if (share.value != 0.0 && quantised > largestQuantised) {
+      largestQuantised = quantised;
       largestSigned = share.value;
+    }
   }
   const double sign = largestSigned < 0.0 ? -1.0 : 1.0;
   std::vector<ElementForce> kept;
