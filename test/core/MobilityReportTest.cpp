@@ -10,6 +10,7 @@
 
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
+#include "mobility_analysis/generators/FamilyRegistry.hpp"
 #include "mobility_analysis/generators/ParametricFamilies.hpp"
 #include "mobility_analysis/generators/ScalingFamilies.hpp"
 // A private header of the core: toJson with its threshold for the second thread.
@@ -135,6 +136,51 @@ INSTANTIATE_TEST_SUITE_P(
                      true},
         ScaledFamily{"braced", [] { return makeBarLattice(3, 3, true); }, AnalysisMode::Auto, false}),
     [](const ::testing::TestParamInfo<ScaledFamily>& info) { return std::string(info.param.name); });
+
+// Every family the generator knows, at a small size, in both modes: the same report at x1, x1000 and x0.001
+// but for its units (the failure message names the family, the mode and the scale).
+TEST(MobilityReport, EveryGeneratedFamilyGivesTheSameReportInAnyUnit) {
+  const std::regex cables("\\n  \"cables\": [^\\n]*");
+  int compared = 0;
+  for (const FamilyInfo& family : listFamilies()) {
+    GenerateRequest request;
+    request.family = family.name;
+    request.visuals = false;
+    // The fewest counts it takes, each 3 (every family is closed and small there; a ring pantograph needs 3).
+    request.counts.assign(static_cast<size_t>(family.minCounts), 3);
+    for (const AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial}) {
+      std::string first;
+      for (const double factor : {1.0, 1000.0, 0.001}) {
+        SCOPED_TRACE(family.name + (mode == AnalysisMode::Auto ? " auto x" : " spatial x") +
+                     std::to_string(factor));
+        request.scale = factor;
+        const GeneratorResult<MechanismDescription> description = generateMechanism(request);
+        ASSERT_TRUE(std::holds_alternative<MechanismDescription>(description));
+        UrdfWriterOptions noVisuals;
+        noVisuals.visuals = false;
+        const GeneratorResult<std::string> urdf =
+            toClosedLoopUrdf(std::get<MechanismDescription>(description), noVisuals);
+        ASSERT_TRUE(std::holds_alternative<std::string>(urdf));
+        const Result<Mechanism> mechanism =
+            loadMechanismFromString(std::get<std::string>(urdf), "family.urdf");
+        ASSERT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+        AnalysisOptions options;
+        options.mode = mode;
+        const Result<MobilityAnalysis> analysis = analyzeMechanism(valueOf(mechanism), options);
+        // A model that cannot be analysed in a mode says so in every unit alike.
+        const std::string text =
+            isOk(analysis) ? std::regex_replace(unitFree(toJson(valueOf(analysis).report)), cables, "")
+                           : diagnosticOf(analysis).what;
+        if (factor == 1.0)
+          first = text;
+        else
+          EXPECT_EQ(first, text);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 150);  // about thirty families, two modes, three scales
+}
 
 TEST(MobilityReport, ElementClassesMarkTheLoopJointRedAndTheLoopOrange) {
   const MobilityReport report =
