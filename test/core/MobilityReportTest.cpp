@@ -7,6 +7,7 @@
 #include <variant>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "core/TestModels.hpp"
 #include "mobility_analysis/generators/ClosedLoopUrdf.hpp"
@@ -180,6 +181,74 @@ TEST(MobilityReport, EveryGeneratedFamilyGivesTheSameReportInAnyUnit) {
     }
   }
   EXPECT_GT(compared, 150);  // about thirty families, two modes, three scales
+}
+
+// Turned in space (every world frame, point and axis of the description), a model keeps what does not depend
+// on its axes: the counts, the redundant joints and links with their numbers of redundant equations, the
+// element classes, the number of states and whether the cables can be prestressed. Which component of a
+// vector equation is the redundant one (a pin's x or y) and the listed basis may change (README, Tolerances).
+TEST(MobilityReport, TurnedInSpaceKeepsTheCountsAndTheRedundantJoints) {
+  const Eigen::Matrix3d turn =
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  auto turned = [&](MechanismDescription m) {
+    const Eigen::Isometry3d pose(turn);
+    for (LinkDescription& link : m.links) {
+      for (Eigen::Vector3d& point : link.visualPath)
+        point = turn * point;
+      if (link.floatingFrame)
+        link.floatingFrame = pose * *link.floatingFrame;
+    }
+    for (Connection& c : m.connections) {
+      c.frame = pose * c.frame;
+      c.axis = turn * c.axis;
+      c.axis2 = turn * c.axis2;
+      c.point2 = turn * c.point2;
+    }
+    for (CableDescription& cable : m.cables) {
+      cable.point1 = turn * cable.point1;
+      cable.point2 = turn * cable.point2;
+    }
+    return m;
+  };
+  auto report = [](const MechanismDescription& m, AnalysisMode mode) {
+    UrdfWriterOptions noVisuals;
+    noVisuals.visuals = false;
+    const GeneratorResult<std::string> urdf = toClosedLoopUrdf(m, noVisuals);
+    EXPECT_TRUE(std::holds_alternative<std::string>(urdf));
+    const Result<Mechanism> mechanism = loadMechanismFromString(
+        std::holds_alternative<std::string>(urdf) ? std::get<std::string>(urdf) : "", "turned.urdf");
+    EXPECT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+    return analyzeOrFail(valueOf(mechanism), mode).report;
+  };
+  const std::vector<std::pair<std::string, MechanismDescription>> families{
+      {"grid", makeParallelogramGrid(3, 4)}, {"truss", makeTrussMast(3)},
+      {"hoberman", makeHobermanRing(6)},     {"braced", makeBarLattice(3, 3, true)},
+      {"sle", makeSleSpatialMast(3)},        {"door", makeDoor(4)}};
+  for (const auto& [name, family] : families) {
+    for (const AnalysisMode mode : {AnalysisMode::Auto, AnalysisMode::Spatial}) {
+      SCOPED_TRACE(name + (mode == AnalysisMode::Auto ? " auto" : " spatial"));
+      const MobilityReport a = report(family, mode), b = report(turned(family), mode);
+      EXPECT_EQ(a.mode, b.mode);
+      EXPECT_EQ(a.dof, b.dof);
+      EXPECT_EQ(a.finiteDof, b.finiteDof);
+      EXPECT_EQ(a.passiveDof, b.passiveDof);
+      EXPECT_EQ(a.grublerKutzbachDof, b.grublerKutzbachDof);
+      EXPECT_EQ(a.numRedundant, b.numRedundant);
+      ASSERT_EQ(a.redundantJoints.size(), b.redundantJoints.size());
+      for (size_t j = 0; j < a.redundantJoints.size(); ++j) {
+        EXPECT_EQ(a.redundantJoints[j].name, b.redundantJoints[j].name);
+        EXPECT_EQ(a.redundantJoints[j].redundantEquations, b.redundantJoints[j].redundantEquations);
+      }
+      EXPECT_EQ(a.redundantLinks, b.redundantLinks);
+      ASSERT_EQ(a.joints.size(), b.joints.size());
+      for (size_t j = 0; j < a.joints.size(); ++j)
+        EXPECT_EQ(a.joints[j].elementClass, b.joints[j].elementClass) << a.joints[j].name;
+      EXPECT_EQ(a.selfStress.count, b.selfStress.count);
+      EXPECT_EQ(a.selfStress.prestressable, b.selfStress.prestressable);
+    }
+  }
 }
 
 TEST(MobilityReport, ElementClassesMarkTheLoopJointRedAndTheLoopOrange) {
