@@ -43,6 +43,16 @@ inline MobilityAnalysis analyzeOrFail(const std::string& path, AnalysisMode mode
   return analyzeOrFail(loadOrFail(path), mode);
 }
 
+/// @p actual's counts are @p expected's: DOF, finite and passive DOF, Grübler, redundant equations, singular.
+inline void expectSameCounts(const MobilityReport& expected, const MobilityReport& actual) {
+  EXPECT_EQ(actual.dof, expected.dof);
+  EXPECT_EQ(actual.finiteDof, expected.finiteDof);
+  EXPECT_EQ(actual.passiveDof, expected.passiveDof);
+  EXPECT_EQ(actual.grublerKutzbachDof, expected.grublerKutzbachDof);
+  EXPECT_EQ(actual.numRedundant, expected.numRedundant);
+  EXPECT_EQ(actual.singular, expected.singular);
+}
+
 /// A mechanism assembled from its written (tree) pose, with the constraint Jacobian there.
 struct ModelAtTreePose {
   Mechanism mechanism;
