@@ -48,6 +48,7 @@ Result<AssembledMechanism> assembleFrom(const Mechanism& mechanism, const LinkPo
     // the same but for rounding, and the joint values read off them would be rounding too (a PUMA 560's
     // joint2 at -5.6e-17 rad). Where it closes, nothing moved: its poses are kept, its values are the written
     // ones, exactly (writtenJointPositions), and a 10^5-link chain skips both passes.
+    // (startPoses is *writtenPoses when that is given: moved from here, it is read as `start` only.)
     LinkPoses poses =
         writtenPoses != nullptr ? std::move(*writtenPoses) : reposeTree(mechanism, layout, startPoses);
     const LinkPoses& start = writtenPoses != nullptr ? poses : startPoses;
