@@ -22,6 +22,12 @@ constexpr double kProjected = 1e-13;
 /// A quadratic form Q_ω whose entries are below this fraction of its scale (Σ |ω_i| |H_i| |x|^2) vanishes
 /// [-].
 constexpr double kSecondOrder = 1e-6;
+/// Q_ω is measured against the larger of its scale and this fraction of Σ|ω_i| (what unit Hessians and unit
+/// motions would give) [-]. Why: a stress over equations the motions leave still (or whose Hessians vanish)
+/// has a scale of rounding, 1e-17, and its Q_ω of rounding too; their ratio came out of order 1 and read as
+/// a second-order obstruction. A triangular-prism scissor mast, which deploys, was then called singular,
+/// and its finite DOF left to stepping, which read 0 when its elements were written in another order.
+constexpr double kFormScaleFloor = 1e-9;
 /// A projected step that ends closer to the pose than this fraction of the step came back: no motion there
 /// [-].
 constexpr double kReturned = 0.25;
@@ -139,7 +145,7 @@ FiniteMobility analyzeFiniteMobility(const CoordinateModel& model, const Eigen::
   // Q_ω per stress, relative to its scale. Stress coefficients refer to unit-norm rows: ω_i = y_i / |J_i|.
   Eigen::MatrixXd forms = Eigen::MatrixXd::Zero(numStresses, pairs);
   for (int s = 0; s < numStresses; ++s) {
-    double scale = 0.0;
+    double scale = 0.0, weight = 0.0;
     for (const auto& [row, y] : basis.stresses[s]) {
       const double norm = J.row(row).norm();
       if (norm <= 0.0)
@@ -147,7 +153,9 @@ FiniteMobility analyzeFiniteMobility(const CoordinateModel& model, const Eigen::
       const double omega = y / norm;
       forms.row(s) += omega * h.col(slot[row]).transpose();
       scale += std::abs(omega) * magnitude(slot[row]);
+      weight += std::abs(omega);
     }
+    scale = std::max(scale, kFormScaleFloor * weight);
     forms.row(s) = scale > 0.0 ? (forms.row(s) / scale).eval() : Eigen::RowVectorXd::Zero(pairs).eval();
   }
   int configurationRank = 0;
