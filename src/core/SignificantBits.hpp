@@ -1,9 +1,9 @@
 #pragma once
 
 // Private to src/core: numbers compared or handed on only to the digits that mean something, so that a
-// model's rounding (millimetres instead of metres, another pose of the same model) cannot change what the
-// report shows. Used by the self-stress report (analysis/SelfStressReport.cpp: the order of a state's
-// elements, the sign of a state) and the prestress program (analysis/Prestress.cpp: its coefficients).
+// model's rounding (the same model in millimetres instead of metres) cannot change what the report shows.
+// Used by the self-stress report (analysis/SelfStressReport.cpp: the order of a state's elements, the sign of
+// a state) and the prestress program (analysis/Prestress.cpp: its coefficients).
 
 #include <cmath>
 #include <cstdint>
