@@ -106,6 +106,10 @@ struct Mechanism {
   std::optional<int> findParentJoint(int link) const;
 };
 
+/// Whether @p joint is a revolute, continuous or prismatic tree joint: one value [rad or m] says where it is
+/// (the joints whose positions a report lists and a caller may hold).
+bool hasSingleValue(const Joint& joint);
+
 /// @return The 1-DOF tree joints coupling @p coupling ties: its follower, its leader, then the joints summed
 ///         with either (Joint::moreFollowers, Joint::moreLeaders).
 std::vector<int> coupledJoints(const Joint& coupling);

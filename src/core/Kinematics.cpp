@@ -64,13 +64,6 @@ std::vector<NameKey> sortedByName(const std::vector<std::pair<std::string_view, 
   return keyed;
 }
 
-/// A revolute, continuous or prismatic tree joint: one value, read off the poses by computeJointPositions.
-bool hasSingleValue(const Joint& joint) {
-  return joint.kind == ConnectionKind::TreeJoint &&
-         (joint.type == JointType::Revolute || joint.type == JointType::Continuous ||
-          joint.type == JointType::Prismatic);
-}
-
 /**
  * @brief The map of @p values (name, value), the last value of a name kept, as operator[] in their order
  * gave.

@@ -38,6 +38,12 @@ std::vector<int> coupledJoints(const Joint& coupling) {
   return joints;
 }
 
+bool hasSingleValue(const Joint& joint) {
+  return joint.kind == ConnectionKind::TreeJoint &&
+         (joint.type == JointType::Revolute || joint.type == JointType::Continuous ||
+          joint.type == JointType::Prismatic);
+}
+
 const char* toString(JointType type) {
   switch (type) {
     case JointType::Revolute:

@@ -46,10 +46,7 @@ Result<JointPositions> makeJointPositions(const std::vector<std::string>& names,
                             "is not a joint of '" + mechanism.name + "'");
     }
     const Joint& j = mechanism.joints[*joint];
-    const bool singleValue =
-        j.kind == ConnectionKind::TreeJoint &&
-        (j.type == JointType::Revolute || j.type == JointType::Continuous || j.type == JointType::Prismatic);
-    if (!singleValue) {
+    if (!hasSingleValue(j)) {
       return makeDiagnostic(mechanism.file, "positions", names[i],
                             std::string("is a ") + toString(j.kind) + " of type " + toString(j.type) +
                                 "; only revolute, continuous and prismatic tree joints take a position");

@@ -65,12 +65,6 @@ bool guarded(const char* service, Response& response, Callback&& callback) {
   return true;  // A false return would drop the message.
 }
 
-bool isOneDofTreeJoint(const Joint& joint) {
-  return joint.kind == ConnectionKind::TreeJoint &&
-         (joint.type == JointType::Revolute || joint.type == JointType::Continuous ||
-          joint.type == JointType::Prismatic);
-}
-
 }  // namespace
 
 MobilityServer::MobilityServer(ros::NodeHandle& nodeHandle, ros::NodeHandle& privateNodeHandle)
@@ -440,7 +434,7 @@ bool MobilityServer::move(Move::Request& request, Move::Response& response) {
       name = response.driveable_joints[request.free_direction];
     }
     const std::optional<int> index = mechanism.findJoint(name);
-    if (!index || !isOneDofTreeJoint(mechanism.joints[*index])) {
+    if (!index || !hasSingleValue(mechanism.joints[*index])) {
       response.message = "move: joint '" + name + "' is not a revolute, continuous or prismatic tree joint";
       return;
     }
@@ -613,7 +607,7 @@ void MobilityServer::onJointStates(const sensor_msgs::JointStateConstPtr& messag
     JointPositions driven;
     for (size_t i = 0; i < message->name.size() && i < message->position.size(); ++i) {
       const std::optional<int> index = mechanism.findJoint(message->name[i]);
-      if (!index || !isOneDofTreeJoint(mechanism.joints[*index]) || !std::isfinite(message->position[i])) {
+      if (!index || !hasSingleValue(mechanism.joints[*index]) || !std::isfinite(message->position[i])) {
         ROS_WARN_THROTTLE(5.0,
                           "input_joint_states: '%s' is not a revolute, continuous or prismatic tree joint of "
                           "'%s' with a finite value; ignored",

@@ -194,12 +194,6 @@ bool needsAxis(JointType type) {
          type == JointType::Cylindrical || type == JointType::Universal;
 }
 
-bool isOneFreedom(const Joint& joint) {
-  return joint.kind == ConnectionKind::TreeJoint &&
-         (joint.type == JointType::Revolute || joint.type == JointType::Continuous ||
-          joint.type == JointType::Prismatic);
-}
-
 /// A coupling as written, resolved once every tree joint is known.
 struct PendingCoupling {
   std::string name;
@@ -802,7 +796,7 @@ class Reader {
     // A tree joint of one freedom, or the refusal naming it in its @p role.
     auto checkOneFreedom = [&](int found, const char* role) {
       const Joint& tree = mechanism_.joints[static_cast<size_t>(found)];
-      if (!isOneFreedom(tree)) {
+      if (!hasSingleValue(tree)) {
         fail(pending.kind, element,
              std::string(role) + " '" + tree.name + "' is " + toString(tree.type) +
                  "; only revolute, continuous and prismatic joints can be coupled");
