@@ -34,6 +34,12 @@ namespace {
 Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const AnalysisOptions& options,
                                           const std::vector<bool>& lockedCables);
 
+/// Whether @p options start from the written pose with nothing driven (assembleMechanism's overload without
+/// a start, which keeps that pose and its exact joint values where the loops close there).
+bool fromWrittenPose(const AnalysisOptions& options) {
+  return !options.startPoses && options.positions.empty();
+}
+
 }  // namespace
 
 Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const AnalysisOptions& options) {
@@ -45,12 +51,12 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
     return analyzeAssembled(mechanism, options, {});
   // Lock at the pose the free mechanism assembles to, then analyse the locked copy from there.
   Result<AssembledMechanism> free =
-      options.startPoses || !options.positions.empty()
-          ? assembleMechanism(
+      fromWrittenPose(options)
+          ? assembleMechanism(mechanism, options.mode)
+          : assembleMechanism(
                 mechanism,
                 options.startPoses ? *options.startPoses : computeTreePoses(mechanism, options.positions),
-                options.mode)
-          : assembleMechanism(mechanism, options.mode);
+                options.mode);
   if (!isOk(free))
     return diagnosticOf(free);
   std::vector<bool> locked;
@@ -58,9 +64,7 @@ Result<MobilityAnalysis> analyzeMechanism(const Mechanism& mechanism, const Anal
   AnalysisOptions lockedOptions = options;
   // From the free pose; where that is the written pose, closed there without moving, the locked copy (the
   // same tree) starts from its own written pose, the same poses, and keeps its exact joint values.
-  const bool atWrittenPose =
-      !options.startPoses && options.positions.empty() && valueOf(free).iterations == 0;
-  if (!atWrittenPose)
+  if (!fromWrittenPose(options) || valueOf(free).iterations > 0)
     lockedOptions.startPoses = valueOf(free).poses;
   return analyzeAssembled(lockedMechanism, lockedOptions, locked);
 }
@@ -103,11 +107,11 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   // Driven positions are held exactly and reached by continuation from the start (the previous state, else
   // the written pose), so the mechanism stays in the start's assembly mode (motion/DrivenAssembly.hpp).
   Result<AssembledMechanism> assembled =
-      options.startPoses || !options.positions.empty()
-          ? assembleMechanism(mechanism,
+      fromWrittenPose(options)
+          ? assembleMechanism(mechanism, options.mode, options.sideThreads)
+          : assembleMechanism(mechanism,
                               options.startPoses ? *options.startPoses : computeTreePoses(mechanism, {}),
-                              options.mode, options.positions, options.sideThreads)
-          : assembleMechanism(mechanism, options.mode, options.sideThreads);
+                              options.mode, options.positions, options.sideThreads);
   if (!isOk(assembled))
     return diagnosticOf(assembled);
   MobilityAnalysis analysis;
