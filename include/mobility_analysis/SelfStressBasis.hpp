@@ -52,7 +52,11 @@ struct SelfStressBasis {
   /// whether contractEchelon is needed (computeOrderedRankFromStresses then reads it instead of reducing
   /// again, at the same tolerance); else empty. Whoever changes `stresses` afterwards must reset it.
   std::optional<StressEchelon> echelon;
-  static constexpr size_t kMaxMotions = 256;
+  /// The most first-order motions the second-order test forms its quadratic forms for (d (d + 1) / 2
+  /// entries each, FiniteMobility.hpp), and so the most the sweep computes: past it nothing reads them, and
+  /// they cost d dense vectors of num_coordinates (a pin-jointed bar lattice of 100 x 100 cells, d = 199:
+  /// 190 MB, and a quarter of its report's instructions).
+  static constexpr size_t kMaxMotions = 64;
 };
 
 /// Progress of a long computation: a fraction in [0, 1]; may be empty.

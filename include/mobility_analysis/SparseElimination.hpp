@@ -94,7 +94,7 @@ class SparseElimination {
    * addRow's residual is the reduced row, zero at the pivot columns; it is never below this distance, and
    * where the pivot rows are nearly dependent (a long ring) it carries their rounding, amplified. The
    * distance is read off a basis of the right null space of the pivot rows (nullSpace), orthonormalised:
-   * |Q^T x|. Cost: the fill per free column.
+   * |Q^T x|. Cost: nullSpace's, and a dense QR of its vectors.
    * @param[in] maxNullity give up (return nothing) when more than this many columns hold no pivot.
    */
   std::optional<double> distanceFromPivotRows(const SparseJacobian& J, int r, double scale,
@@ -119,7 +119,7 @@ class SparseElimination {
    * @brief A basis of the right null space of the rows added so far (the first-order motions when every row
    * of J was added): one vector per column that never became a pivot, 1 there and 0 at the other free
    * columns, the pivot columns by back-substitution from the latest pivot row (each pivot row is zero at the
-   * pivot columns of earlier ones). Cost: the fill, per vector.
+   * pivot columns of earlier ones). Cost: the pivot rows each vector reaches, per vector.
    * @param[in] maxVectors give up (return nothing) when there are more free columns than this.
    */
   std::optional<std::vector<Eigen::VectorXd>> nullSpace(size_t maxVectors) const;
@@ -131,6 +131,9 @@ class SparseElimination {
 
  private:
   int priority(int column) const { return columnPriority_.empty() ? column : columnPriority_[column]; }
+  /// Where each column's list starts among the lists of the pivot rows holding each column outside their own
+  /// pivot column (n + 1 offsets): nullSpace's transpose of the pivot rows.
+  std::vector<size_t> pivotRowsByColumnStart() const;
 
   /**
    * A set of pivot indices taken smallest first: a bit per pivot, and a bit per 64-bit word of them that is

@@ -254,20 +254,62 @@ std::optional<std::vector<Eigen::VectorXd>> SparseElimination::nullSpace(size_t 
   if (freeColumns.size() > maxVectors)
     return std::nullopt;
   std::vector<Eigen::VectorXd> basis;
+  if (freeColumns.empty())
+    return basis;
+  // x is 0 at every pivot column no non-zero reaches from the free column: back-substitution visits only the
+  // pivot rows holding a column where x is not 0, latest first (each reads pivot columns of later rows
+  // only). Why: visiting every row cost the whole fill per vector; on a pin-jointed bar lattice of 100 x 100
+  // cells, whose 199 motions each move a few rows of cells, that was 59% of the main thread's instructions.
+  const std::vector<size_t> rowsStart = pivotRowsByColumnStart();
+  std::vector<int> rowsOfColumn(rowsStart.back());
+  std::vector<size_t> fill(rowsStart.begin(), rowsStart.end() - 1);
+  for (int k = 0; k < rank(); ++k) {
+    for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
+      if (entries_[i].first != column_[k])
+        rowsOfColumn[fill[static_cast<size_t>(entries_[i].first)]++] = k;
+    }
+  }
+  // The pivots to visit, latest first: the queue takes the smallest, so pivot k is queued as rank - 1 - k.
+  PivotQueue pending;
+  pending.resize(static_cast<size_t>(rank()));
+  auto queueRowsHolding = [&](int column) {
+    for (size_t i = rowsStart[column]; i < rowsStart[column + 1]; ++i)
+      pending.push(rank() - 1 - rowsOfColumn[i]);
+  };
   for (int f : freeColumns) {
+    // Where no non-zero reaches, the full back-substitution wrote -0 / pivot: the same zeros, to the sign.
     Eigen::VectorXd x = Eigen::VectorXd::Zero(numColumns());
+    for (int k = 0; k < rank(); ++k)
+      x(column_[k]) = -0.0 / pivot_[k];
     x(f) = 1.0;
-    for (int k = rank() - 1; k >= 0; --k) {
+    queueRowsHolding(f);
+    while (!pending.empty()) {
+      const int k = rank() - 1 - pending.pop();
       double sum = 0.0;
       for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
         if (entries_[i].first != column_[k])
           sum += entries_[i].second * x(entries_[i].first);
       }
       x(column_[k]) = -sum / pivot_[k];
+      if (x(column_[k]) != 0.0)
+        queueRowsHolding(column_[k]);
     }
     basis.push_back(std::move(x));
   }
   return basis;
+}
+
+std::vector<size_t> SparseElimination::pivotRowsByColumnStart() const {
+  std::vector<size_t> start(static_cast<size_t>(numColumns()) + 1, 0);
+  for (int k = 0; k < rank(); ++k) {
+    for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
+      if (entries_[i].first != column_[k])
+        ++start[static_cast<size_t>(entries_[i].first) + 1];
+    }
+  }
+  for (size_t c = 1; c < start.size(); ++c)
+    start[c] += start[c - 1];
+  return start;
 }
 
 }  // namespace mobility_analysis

@@ -12,6 +12,7 @@
 #include <set>
 
 #include <gtest/gtest.h>
+#include <Eigen/LU>
 
 #include "core/RandomMatrices.hpp"
 #include "core/TestModels.hpp"
@@ -352,6 +353,36 @@ TEST(SparseElimination, ReducingOverTheFirstPivotsGivesTheReductionTheRowHadThen
     elimination.reduceOver(J, then.row, 1.0 / J.row(then.row).norm(), then.pivots);
     EXPECT_EQ(elimination.multipliers(), then.multipliers) << then.row;
     EXPECT_EQ(elimination.traceDependency(then.row, elimination.multipliers()), then.trace) << then.row;
+  }
+}
+
+TEST(SparseElimination, TheNullSpaceIsTheDenseNullSpace) {
+  // nullSpace back-substitutes only the pivot rows a free column reaches. Checked against a dense LU of the
+  // same matrix: as many vectors as its nullity, each in its null space, together of full rank.
+  std::mt19937 random(5);
+  const ModelAtTreePose lattice = assembleAtTreePose(generated(makeBarLattice(8, 8)), AnalysisMode::Planar);
+  const std::vector<std::pair<std::string, SparseJacobian>> matrices = {
+      {"random", SparseJacobian(makeRankDeficientMatrix(random, 80, 120, 30).sparseView())},
+      {"bar lattice 8 x 8", lattice.J}};
+  for (const auto& [name, J] : matrices) {
+    const Eigen::MatrixXd dense(J);
+    SparseElimination elimination(static_cast<int>(J.cols()), {}, tolerances::kRank, false);
+    for (int r = 0; r < J.rows(); ++r)
+      elimination.addRow(J, r, 1.0 / J.row(r).norm());
+    const auto nullity = static_cast<size_t>(J.cols() - Eigen::FullPivLU<Eigen::MatrixXd>(dense).rank());
+    ASSERT_GE(nullity, 15u) << name;
+    EXPECT_FALSE(elimination.nullSpace(nullity - 1).has_value()) << name;
+    const std::optional<std::vector<Eigen::VectorXd>> basis = elimination.nullSpace(nullity);
+    ASSERT_TRUE(basis.has_value()) << name;
+    ASSERT_EQ(basis->size(), nullity) << name;
+    Eigen::MatrixXd N(J.cols(), static_cast<Eigen::Index>(nullity));
+    for (size_t k = 0; k < nullity; ++k) {
+      N.col(static_cast<Eigen::Index>(k)) = (*basis)[k];
+      EXPECT_LT((dense * (*basis)[k]).cwiseAbs().maxCoeff(),
+                1e-12 * dense.cwiseAbs().maxCoeff() * (*basis)[k].cwiseAbs().maxCoeff())
+          << name << " vector " << k;
+    }
+    EXPECT_EQ(static_cast<size_t>(Eigen::FullPivLU<Eigen::MatrixXd>(N).rank()), nullity) << name;
   }
 }
 

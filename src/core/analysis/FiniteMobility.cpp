@@ -38,8 +38,6 @@ constexpr int kRandomSamples = 4;
 /// The share of a random combination added to each basis direction sampled at a singular pose [-]: enough to
 /// leave the singular set by far more than the rank tolerance after one step (kStep times this).
 constexpr double kGenericShare = 0.3;
-/// The second-order test forms Q_ω for up to this many first-order motions (d (d + 1) / 2 entries each).
-constexpr int kMaxSecondOrderMotions = 64;
 /// Stresses are split into structural and configuration ones densely up to this many.
 constexpr int kMaxDenseStresses = 2000;
 
@@ -102,7 +100,8 @@ FiniteMobility analyzeFiniteMobility(const CoordinateModel& model, const Eigen::
   // No self-stress: J has full row rank, the configuration set is a manifold of dimension nullity.
   if (numStresses == 0 || ranks.dof() == 0)
     return result;
-  if (!basis.motionsComputed || static_cast<int>(basis.motions.size()) > kMaxSecondOrderMotions) {
+  // The sweep keeps the motions only up to the number this test forms Q_ω for (SelfStressBasis::kMaxMotions).
+  if (!basis.motionsComputed) {
     result.note = "too many first-order motions for the second-order test; finite_dof is the nullity";
     return result;
   }
