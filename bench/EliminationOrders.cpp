@@ -6,8 +6,6 @@
 #include <numeric>
 #include <vector>
 
-#include <amd.h>
-
 #include "mobility_analysis/EliminationOrder.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
@@ -18,39 +16,6 @@ namespace {
 /// An order gives up once it has stored this many times J's entries, plus kBudgetFloor.
 constexpr size_t kBudgetFactor = 60;
 constexpr size_t kBudgetFloor = 2000000;
-
-/// The links in SuiteSparse AMD's order of the graph whose edges are the connections with equations: minimum
-/// degree takes pendant links first (a tree from its leaves) and cuts long paths and grids where it fills
-/// least.
-std::vector<int> minimumDegreeLinks(const Mechanism& mechanism, const CoordinateModel& model) {
-  const int n = static_cast<int>(mechanism.links.size());
-  std::vector<char> hasRows(mechanism.joints.size(), 0);
-  for (const ConstraintEquation& eq : model.equations) {
-    if (eq.source == EquationSource::Joint)
-      hasRows[eq.element] = 1;
-  }
-  std::vector<std::vector<int>> neighbours(n);
-  for (size_t j = 0; j < mechanism.joints.size(); ++j) {
-    const Joint& joint = mechanism.joints[j];
-    if (!hasRows[j] || joint.link1 == joint.link2)
-      continue;
-    neighbours[joint.link1].push_back(joint.link2);
-    neighbours[joint.link2].push_back(joint.link1);
-  }
-  std::vector<int> columnStart(n + 1, 0), rowIndex;
-  for (int l = 0; l < n; ++l) {
-    std::sort(neighbours[l].begin(), neighbours[l].end());
-    neighbours[l].erase(std::unique(neighbours[l].begin(), neighbours[l].end()), neighbours[l].end());
-    rowIndex.insert(rowIndex.end(), neighbours[l].begin(), neighbours[l].end());
-    columnStart[l + 1] = static_cast<int>(rowIndex.size());
-  }
-  std::vector<int> order(n);
-  double control[AMD_CONTROL], info[AMD_INFO];
-  amd_defaults(control);
-  if (amd_order(n, columnStart.data(), rowIndex.data(), order.data(), control, info) < AMD_OK)
-    std::iota(order.begin(), order.end(), 0);
-  return order;
-}
 
 /// The rows of J in contract order, the columns by index: the lecture's order.
 EliminationOrder contractOrder(const SparseJacobian& J) {
@@ -104,7 +69,7 @@ int printEliminationOrders(const Mechanism& mechanism, const CoordinateModel& mo
   const EliminationOrder sweep = computeSweepOrder(mechanism, model);
   eliminate("sweep", secondsSince(start), sweep, J, file);
   start = std::chrono::steady_clock::now();
-  const EliminationOrder amd = computeOrderOfLinks(mechanism, model, minimumDegreeLinks(mechanism, model));
+  const EliminationOrder amd = computeMinimumDegreeOrder(mechanism, model);
   eliminate("amd", secondsSince(start), amd, J, file);
   eliminate("contract", 0.0, contractOrder(J), J, file, 1.0);
   return 0;

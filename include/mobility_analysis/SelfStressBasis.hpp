@@ -23,6 +23,13 @@ struct StressEchelon {
   double tolerance = 0.0;  ///< The threshold it was made with.
 };
 
+/// The order of the links the sweep's elimination took (computeSelfStressBasis tries them in this order).
+enum class SweepOrderKind {
+  FromTheGround,  ///< computeSweepOrder (also its unlimited run, when the others fill as well)
+  FromTheLeaves,  ///< its spanning tree from the leaves, the closing connections after it
+  MinimumDegree,  ///< computeMinimumDegreeOrder
+};
+
 /**
  * @brief A basis of the left null space of the constraint Jacobian: its self-stresses.
  *
@@ -40,6 +47,7 @@ struct SelfStressBasis {
   double smallestKeptPivot = 0.0;       ///< Of the sweep's elimination (see OrderedRank) [-].
   double largestDroppedResidual = 0.0;  ///< Likewise [-].
   int locallyResolved = 0;              ///< Stresses found by a local elimination around their equation.
+  SweepOrderKind sweptBy = SweepOrderKind::FromTheGround;  ///< The order the elimination took.
   /// A basis of the first-order motions (right null space of J, dim num_coordinates each) from the same
   /// elimination; empty with motionsComputed false when there were more than kMaxMotions.
   std::vector<Eigen::VectorXd> motions;

@@ -1,8 +1,11 @@
 #include "mobility_analysis/EliminationOrder.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <queue>
 #include <tuple>
+
+#include <amd.h>
 
 #include "Buckets.hpp"
 
@@ -127,6 +130,29 @@ std::vector<int> maximumCardinalitySweep(const Mechanism& mechanism, const Sweep
   return sweep;
 }
 
+/// The links in SuiteSparse AMD's approximate minimum degree order of the graph whose edges are the
+/// connections with equations (computeMinimumDegreeOrder); in index order should AMD refuse the graph.
+std::vector<int> minimumDegreeLinks(const SweepGraph& graph) {
+  const int numLinks = graph.numLinks;
+  // AMD reads the graph as a symmetric pattern in compressed columns: each link's neighbours, each once.
+  std::vector<int> columnStart(static_cast<size_t>(numLinks) + 1, 0), neighbours;
+  for (int l = 0; l < numLinks; ++l) {
+    const size_t first = neighbours.size();
+    for (int j : graph.incident(l))
+      neighbours.push_back(graph.otherEnd(j, l));
+    std::sort(neighbours.begin() + static_cast<std::ptrdiff_t>(first), neighbours.end());
+    neighbours.erase(std::unique(neighbours.begin() + static_cast<std::ptrdiff_t>(first), neighbours.end()),
+                     neighbours.end());
+    columnStart[static_cast<size_t>(l) + 1] = static_cast<int>(neighbours.size());
+  }
+  std::vector<int> order(static_cast<size_t>(numLinks));
+  double control[AMD_CONTROL], info[AMD_INFO];
+  amd_defaults(control);
+  if (amd_order(numLinks, columnStart.data(), neighbours.data(), order.data(), control, info) < AMD_OK)
+    std::iota(order.begin(), order.end(), 0);
+  return order;
+}
+
 /// The rows and column priorities of a sweep over the links in the order @p sweep (computeSweepOrder).
 EliminationOrder orderFromSweep(const CoordinateModel& model, const SweepGraph& graph,
                                 const std::vector<int>& sweep) {
@@ -207,6 +233,11 @@ EliminationOrder orderFromSweep(const CoordinateModel& model, const SweepGraph& 
 EliminationOrder computeSweepOrder(const Mechanism& mechanism, const CoordinateModel& model) {
   const SweepGraph graph(mechanism, model);
   return orderFromSweep(model, graph, maximumCardinalitySweep(mechanism, graph));
+}
+
+EliminationOrder computeMinimumDegreeOrder(const Mechanism& mechanism, const CoordinateModel& model) {
+  const SweepGraph graph(mechanism, model);
+  return orderFromSweep(model, graph, minimumDegreeLinks(graph));
 }
 
 EliminationOrder computeOrderOfLinks(const Mechanism& mechanism, const CoordinateModel& model,
