@@ -131,9 +131,6 @@ class SparseElimination {
 
  private:
   int priority(int column) const { return columnPriority_.empty() ? column : columnPriority_[column]; }
-  /// Where each column's list starts among the lists of the pivot rows holding each column outside their own
-  /// pivot column (n + 1 offsets): nullSpace's transpose of the pivot rows.
-  std::vector<size_t> pivotRowsByColumnStart() const;
 
   /**
    * A set of pivot indices taken smallest first: a bit per pivot, and a bit per 64-bit word of them that is

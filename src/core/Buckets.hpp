@@ -1,7 +1,8 @@
 #pragma once
 
 // Private to src/core: integers grouped by a key in one pooled array, for the per-link and per-joint lists of
-// the sweep order (EliminationOrder.cpp) and the passive-freedom search (analysis/PassiveFreedoms.cpp).
+// the sweep order (EliminationOrder.cpp) and the passive-freedom search (analysis/PassiveFreedoms.cpp), and
+// the pivot rows by column (SparseElimination::nullSpace).
 
 #include <cstddef>
 #include <vector>

@@ -289,11 +289,17 @@ SelfStressBasis sweepSelfStressBasis(const Mechanism& mechanism, const Coordinat
   // each link's rows pivot on its own coordinates before its parent's are seen, and nothing fills in.
   const bool tree = std::all_of(mechanism.joints.begin(), mechanism.joints.end(),
                                 [&](const Joint& joint) { return joint.kind == ConnectionKind::TreeJoint; });
+  // One elimination in @p by, within @p budget, remembering which order it took.
+  auto sweepIn = [&](const EliminationOrder& by, FillBudget budget, SweepOrderKind kind) {
+    std::optional<SelfStressBasis> basis =
+        sweepBasis(mechanism, model, J, by, tolerance, budget, findAhead, progress);
+    if (basis)
+      basis->sweptBy = kind;
+    return basis;
+  };
   std::optional<SelfStressBasis> found;
   if (tree) {
-    found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, FillBudget::none(), findAhead,
-                       progress);
-    found->sweptBy = SweepOrderKind::FromTheLeaves;
+    found = sweepIn(leavesFirst(order), FillBudget::none(), SweepOrderKind::FromTheLeaves);
   } else {
     // Loops can fill the same way: each arc of a long ring is such a chain, and swept from the ground the
     // 2.5 10^4 links of a ring stored 3 10^8 entries (10^5 links: out of memory). The sweep from the ground
@@ -312,22 +318,15 @@ SelfStressBasis sweepSelfStressBasis(const Mechanism& mechanism, const Coordinat
     // short one: 2 x 5 000 cells took 9.7 s and 2.1 GB), the links are taken in a minimum degree order of
     // their graph, which eliminates each short bar onto the long ones it crosses (computeMinimumDegreeOrder).
     const FillBudget budget = FillBudget::total(kFillFactor * static_cast<size_t>(J.nonZeros()) + kFillFloor);
-    found = sweepBasis(mechanism, model, J, order, tolerance,
-                       fillBudget > 0 ? FillBudget::total(fillBudget) : FillBudget::proportional(kFillFactor),
-                       findAhead, progress);
-    if (!found) {
-      found = sweepBasis(mechanism, model, J, leavesFirst(order), tolerance, budget, findAhead, progress);
-      if (found)
-        found->sweptBy = SweepOrderKind::FromTheLeaves;
-    }
-    if (!found) {
-      found = sweepBasis(mechanism, model, J, computeMinimumDegreeOrder(mechanism, model), tolerance, budget,
-                         findAhead, progress);
-      if (found)
-        found->sweptBy = SweepOrderKind::MinimumDegree;
-    }
+    found =
+        sweepIn(order, fillBudget > 0 ? FillBudget::total(fillBudget) : FillBudget::proportional(kFillFactor),
+                SweepOrderKind::FromTheGround);
     if (!found)
-      found = sweepBasis(mechanism, model, J, order, tolerance, FillBudget::none(), findAhead, progress);
+      found = sweepIn(leavesFirst(order), budget, SweepOrderKind::FromTheLeaves);
+    if (!found)
+      found = sweepIn(computeMinimumDegreeOrder(mechanism, model), budget, SweepOrderKind::MinimumDegree);
+    if (!found)
+      found = sweepIn(order, FillBudget::none(), SweepOrderKind::FromTheGround);
   }
   SelfStressBasis basis = std::move(*found);
 

@@ -6,6 +6,7 @@
 
 #include <Eigen/QR>
 
+#include "Buckets.hpp"
 #include "mobility_analysis/Tolerances.hpp"
 
 namespace mobility_analysis {
@@ -260,21 +261,25 @@ std::optional<std::vector<Eigen::VectorXd>> SparseElimination::nullSpace(size_t 
   // pivot rows holding a column where x is not 0, latest first (each reads pivot columns of later rows
   // only). Why: visiting every row cost the whole fill per vector; on a pin-jointed bar lattice of 100 x 100
   // cells, whose 199 motions each move a few rows of cells, that was 59% of the main thread's instructions.
-  const std::vector<size_t> rowsStart = pivotRowsByColumnStart();
-  std::vector<int> rowsOfColumn(rowsStart.back());
-  std::vector<size_t> fill(rowsStart.begin(), rowsStart.end() - 1);
-  for (int k = 0; k < rank(); ++k) {
-    for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
-      if (entries_[i].first != column_[k])
-        rowsOfColumn[fill[static_cast<size_t>(entries_[i].first)]++] = k;
+  // The transpose of the pivot rows: the pivot rows holding each column outside their own pivot column.
+  core_detail::Buckets rowsOfColumn(numColumns());
+  auto forEachOffPivotEntry = [&](auto&& use) {
+    for (int k = 0; k < rank(); ++k) {
+      for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
+        if (entries_[i].first != column_[k])
+          use(entries_[i].first, k);
+      }
     }
-  }
+  };
+  forEachOffPivotEntry([&](int column, int) { rowsOfColumn.count(column); });
+  rowsOfColumn.allocate();
+  forEachOffPivotEntry([&](int column, int k) { rowsOfColumn.add(column, k); });
   // The pivots to visit, latest first: the queue takes the smallest, so pivot k is queued as rank - 1 - k.
   PivotQueue pending;
   pending.resize(static_cast<size_t>(rank()));
   auto queueRowsHolding = [&](int column) {
-    for (size_t i = rowsStart[column]; i < rowsStart[column + 1]; ++i)
-      pending.push(rank() - 1 - rowsOfColumn[i]);
+    for (int k : rowsOfColumn[column])
+      pending.push(rank() - 1 - k);
   };
   for (int f : freeColumns) {
     // Where no non-zero reaches, the full back-substitution wrote -0 / pivot: the same zeros, to the sign.
@@ -297,19 +302,6 @@ std::optional<std::vector<Eigen::VectorXd>> SparseElimination::nullSpace(size_t 
     basis.push_back(std::move(x));
   }
   return basis;
-}
-
-std::vector<size_t> SparseElimination::pivotRowsByColumnStart() const {
-  std::vector<size_t> start(static_cast<size_t>(numColumns()) + 1, 0);
-  for (int k = 0; k < rank(); ++k) {
-    for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
-      if (entries_[i].first != column_[k])
-        ++start[static_cast<size_t>(entries_[i].first) + 1];
-    }
-  }
-  for (size_t c = 1; c < start.size(); ++c)
-    start[c] += start[c - 1];
-  return start;
 }
 
 }  // namespace mobility_analysis
