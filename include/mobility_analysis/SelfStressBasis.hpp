@@ -48,6 +48,8 @@ struct SelfStressBasis {
   double largestDroppedResidual = 0.0;  ///< Likewise [-].
   int locallyResolved = 0;              ///< Stresses found by a local elimination around their equation.
   SweepOrderKind sweptBy = SweepOrderKind::FromTheGround;  ///< The order the elimination took.
+  /// Entries the elimination kept (its pivot rows and their multipliers): its fill, against J's nonzeros.
+  size_t storedEntries = 0;
   /// A basis of the first-order motions (right null space of J, dim num_coordinates each) from the same
   /// elimination; empty with motionsComputed false when there were more than kMaxMotions.
   std::vector<Eigen::VectorXd> motions;

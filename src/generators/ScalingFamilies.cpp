@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -60,6 +61,49 @@ MechanismDescription makeChain(int links, ChainShape shape, ChainOrder order) {
   m.treeJointsLeafFirst = leafFirst;
   m.visualRadius = 0.01;
   m.expectations = expectChain(links);
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+std::vector<FamilyExpectation> expectStar(int arms) {
+  return {expectation("planar", arms + 1, arms + 1), expectation("spatial", arms + 1, arms + 1)};
+}
+
+MechanismDescription makeStar(int arms) {
+  const double radius = std::max(0.1, 0.1 * arms / (2.0 * M_PI));
+  auto direction = [&](int i) {
+    const double angle = 2.0 * M_PI * i / arms;
+    return Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
+  };
+  MechanismDescription m;
+  m.name = "star_" + std::to_string(arms);
+  m.comment =
+      "A hub on a revolute at the ground's origin carrying " + std::to_string(arms) +
+      " arms: joint_i (revolute about z) at angle 2 pi i / N on a circle of radius " +
+      std::to_string(radius) +
+      " m joins the hub and arm_i, 0.1 m long, pointing outwards.\n"
+      "No loop, nothing redundant: every tree equation is independent by construction.\n"
+      "Closed form: planar DOF N+1, Gruebler 3(N+2 - (N+1) - 1) + N+1 = N+1, redundant 0; spatial the "
+      "same.";
+  m.links.reserve(arms + 2);
+  m.connections.reserve(arms + 1);
+  m.links.push_back(link("ground", {Eigen::Vector3d(-0.05, 0, 0), Eigen::Vector3d::Zero()}));
+  std::vector<Eigen::Vector3d> hubPoints{Eigen::Vector3d::Zero()};
+  for (int i = 1; i <= arms; ++i)
+    hubPoints.push_back(radius * direction(i));
+  m.links.push_back(link("hub", hubPoints));
+  for (int i = 1; i <= arms; ++i) {
+    m.links.push_back(
+        link("arm_" + std::to_string(i), {radius * direction(i), (radius + 0.1) * direction(i)}));
+  }
+  m.connections.push_back(
+      makeRevolute("hub_joint", "ground", "hub", Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()));
+  for (int i = 1; i <= arms; ++i) {
+    m.connections.push_back(makeRevolute("joint_" + std::to_string(i), "hub", "arm_" + std::to_string(i),
+                                         radius * direction(i), Eigen::Vector3d::UnitZ()));
+  }
+  m.visualRadius = 0.01;
+  m.expectations = expectStar(arms);
   return m;
 }
 

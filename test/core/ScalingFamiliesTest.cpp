@@ -59,6 +59,12 @@ std::vector<Family> families() {
                     [=] {
                       return std::vector<FamilyExpectation>{planar(n, n), spatial(n, n)};
                     }});
+    // Star: the ground, a hub and N arms, N + 1 revolutes, no loop: 3(N + 2 − (N + 1) − 1) + N + 1 = N + 1 in
+    // the plane, 6·0 + N + 1 in space.
+    list.push_back({"star_" + tag, [n] { return makeStar(n); },
+                    [=] {
+                      return std::vector<FamilyExpectation>{planar(n + 1, n + 1), spatial(n + 1, n + 1)};
+                    }});
     // Ring: N links, N revolutes, one loop: 3(N − N − 1) + N = N − 3; in space 6(−1) + N = N − 6, but every
     // axis is parallel, so the loop's 3 out-of-plane equations are dependent and the DOF stays N − 3.
     list.push_back({"ring_" + tag, [n] { return makeRing(n); },
@@ -97,7 +103,8 @@ TEST(ScalingFamilies, GeneratorsStateTheSameClosedForms) {
   // What the generated file says it expects (its header comment, the registry's line) is what is tested.
   for (int n = 3; n <= 6; ++n) {
     for (const auto& [m, planar, spatialG] :
-         {std::tuple{makeChain(n), n, n}, std::tuple{makeRing(n), n - 3, n - 6}}) {
+         {std::tuple{makeChain(n), n, n}, std::tuple{makeStar(n), n + 1, n + 1},
+          std::tuple{makeRing(n), n - 3, n - 6}}) {
       ASSERT_EQ(m.expectations.size(), 2u);
       EXPECT_EQ(m.expectations[0].grubler, planar);
       EXPECT_EQ(m.expectations[1].grubler, spatialG);
@@ -169,6 +176,8 @@ TEST(ScalingFamilies, ClosedFormsHoldAtAThousandUnits) {
       {"chain", makeChain(n), AnalysisMode::Planar, n, n},
       {"chain zigzag leaf-first", makeChain(n, ChainShape::Zigzag, ChainOrder::LeafFirst),
        AnalysisMode::Planar, n, n},
+      {"star", makeStar(n), AnalysisMode::Planar, n + 1, n + 1},
+      {"star in space", makeStar(n), AnalysisMode::Spatial, n + 1, n + 1},
       {"ring", makeRing(n), AnalysisMode::Planar, n - 3, n - 3},
       {"ring in space", makeRing(n), AnalysisMode::Spatial, n - 3, n - 6},
       {"bar lattice 32x32", makeBarLattice(32, 32), AnalysisMode::Planar, 63, 63},

@@ -226,7 +226,66 @@ std::string ringUrdf(int links) {
          " 0 0'/><axis xyz='0 0 1'/></loop_joint></robot>";
 }
 
+/// A tree of @p links on revolute joints about their z: a star (every link on the first, around it), a
+/// binary tree (link i on link (i - 1) / 2) or a random tree (each link on an earlier one drawn at random,
+/// anywhere in space and turned any way).
+std::string treeUrdf(const std::string& shape, int links) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  auto number = [](double x) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.17g", x);
+    return std::string(text);
+  };
+  std::string text = "<robot name='" + shape + "'><link name='l0'/>";
+  for (int i = 1; i <= links; ++i) {
+    int parent = i - 1;
+    std::string xyz = "0.1 0 0", rpy = "0 0 0";
+    if (shape == "star") {
+      const double angle = 6.283185307179586 * i / links;
+      parent = 0;
+      xyz = number(std::cos(angle)) + " " + number(std::sin(angle)) + " 0";
+      rpy = "0 0 " + number(angle);
+    } else if (shape == "binary") {
+      parent = (i - 1) / 2;
+      xyz = i % 2 == 0 ? "0.1 0.05 0" : "0.1 -0.05 0";
+    } else {
+      parent = static_cast<int>((unit(random) + 1.0) / 2.0 * (i - 1));
+      xyz = number(unit(random)) + " " + number(unit(random)) + " " + number(unit(random));
+      rpy = number(3 * unit(random)) + " " + number(3 * unit(random)) + " " + number(3 * unit(random));
+    }
+    text += "<link name='l" + std::to_string(i) + "'/><joint name='j" + std::to_string(i) +
+            "' type='revolute'><parent link='l" + std::to_string(parent) + "'/><child link='l" +
+            std::to_string(i) + "'/><origin xyz='" + xyz + "' rpy='" + rpy + "'/><axis xyz='0 0 1'/></joint>";
+  }
+  return text + "</robot>";
+}
+
 }  // namespace
+
+TEST(SelfStressBasis, ATreeOfAnyShapeIsSweptWithoutFill) {
+  // A tree has no stress, and swept from its leaves each link's rows pivot on its own coordinates: the
+  // elimination keeps about J's entries whatever the shape. Where a link carries many joints (the hub of a
+  // star), its rigid-link equations for them must pivot on the joints' own elements, not its basis: with the
+  // order within each link reversed along with the links, a star of 2 000 links kept 227 times J's entries
+  // in the plane (8 000 links: 3 GB), and a random tree in space 2.3 times.
+  for (const char* shape : {"star", "binary", "random"}) {
+    Result<Mechanism> mechanism = loadMechanismFromString(treeUrdf(shape, 2000), "tree.urdf");
+    ASSERT_TRUE(isOk(mechanism)) << diagnosticOf(mechanism).toString();
+    for (AnalysisMode mode : {AnalysisMode::Planar, AnalysisMode::Spatial}) {
+      if (std::string(shape) == "random" && mode == AnalysisMode::Planar)
+        continue;  // its axes are not parallel
+      const ModelAtTreePose m = assembleAtTreePose(valueOf(mechanism), mode);
+      const SelfStressBasis basis =
+          computeSelfStressBasis(m.mechanism, m.assembled.model, m.J, tolerances::kRank);
+      const std::string name = std::string(shape) + " " + toString(mode);
+      EXPECT_EQ(basis.sweptBy, SweepOrderKind::FromTheLeaves) << name;
+      EXPECT_TRUE(basis.stresses.empty()) << name;
+      EXPECT_EQ(basis.rank, m.J.rows()) << name;
+      EXPECT_LE(basis.storedEntries, 2 * static_cast<size_t>(m.J.nonZeros())) << name;
+    }
+  }
+}
 
 TEST(SelfStressBasis, ALongRingIsTakenFromItsLeavesAndKeepsTheOrderedAnswer) {
   // Swept from the ground, each arc of a ring fills like a chain swept from its root; past the fill budget

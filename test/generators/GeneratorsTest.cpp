@@ -61,6 +61,8 @@ std::vector<NamedModel> smallModels() {
       {"chain_3", [] { return makeChain(3); }},
       {"chain_5_zigzag", [] { return makeChain(5, ChainShape::Zigzag); }},
       {"chain_4_leaf_first", [] { return makeChain(4, ChainShape::Zigzag, ChainOrder::LeafFirst); }},
+      {"star_1", [] { return makeStar(1); }},
+      {"star_6", [] { return makeStar(6); }},
       {"ring_4", [] { return makeRing(4); }},
       {"ring_7", [] { return makeRing(7); }},
   };

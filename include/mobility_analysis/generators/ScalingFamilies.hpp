@@ -38,6 +38,25 @@ MechanismDescription makeChain(int links, ChainShape shape = ChainShape::Straigh
                                ChainOrder order = ChainOrder::RootFirst);
 
 /**
+ * @brief Closed-form expectations of a star of @p arms arms on one hub (makeStar()).
+ *
+ * Links N + 2 (with the ground), joints N + 1 revolute, no loop: planar (λ 3) DOF N + 1, Grübler
+ * 3(N + 2 − (N + 1) − 1) + N + 1 = N + 1, redundant 0; spatial (λ 6) the same.
+ */
+std::vector<FamilyExpectation> expectStar(int arms);
+
+/**
+ * @brief A star: `hub` on revolute `hub_joint` (about z) at the origin of `ground`, and `arm_1` … `arm_N`
+ *        each on its own revolute `joint_i` (about z) on the hub, at angle 2π i / N on a circle whose
+ *        circumference gives 0.1 m a joint, each arm 0.1 m long pointing outwards. One link carries every
+ *        joint: the tree whose hub's equations must not couple its joints (issue 13: a chain or a star
+ *        costs O(N)).
+ * @param[in] arms N ≥ 1.
+ * @note Expectations: see expectStar().
+ */
+MechanismDescription makeStar(int arms);
+
+/**
  * @brief Closed-form expectations of a single ring of @p links links (N ≥ 3), one of them the ground.
  *
  * Links N, joints N revolute, one loop: planar (λ 3) DOF N − 3, Grübler 3(N − N − 1) + N = N − 3,
