@@ -82,14 +82,12 @@ const std::vector<FamilyInfo>& listFamilies() {
        "triangular-prism scissor mast, spherical face pins; spatial DOF 1 G 3-6N R 6N-2"},
       {"hoberman", 1, 1, "hoberman N (N >= 3)", "Hoberman-type ring; planar DOF 1 G -3 R 4"},
       {"sle_deployable", 1, 2, "sle_deployable N [ELEVATION_DEG=10]",
-       "SLE mast with passive side cables (taut at 45 deg) and an active base cable; planar DOF 1, deployed "
-       "0"},
+       "SLE mast with passive side cables (taut at 45 deg) and an active base cable; planar DOF 1, deployed 0"},
       {"sle_deployable_folded", 0, 0, "sle_deployable_folded", "= sle_deployable 4 10"},
       {"sle_deployable_partly", 0, 0, "sle_deployable_partly", "= sle_deployable 4 30"},
       {"sle_deployable_deployed", 0, 0, "sle_deployable_deployed", "= sle_deployable 4 45"},
       {"ring_pantograph", 1, 2, "ring_pantograph N (N >= 3) [OPENING_DEG=150]",
-       "angulated SLE ring with passive hoop cables (taut at 60 deg) and an active cable; planar DOF 1, "
-       "deployed 0"},
+       "angulated SLE ring with passive hoop cables (taut at 60 deg) and an active cable; planar DOF 1, deployed 0"},
       {"ring_pantograph_folded", 0, 0, "ring_pantograph_folded", "= ring_pantograph 4 150"},
       {"ring_pantograph_deployed", 0, 0, "ring_pantograph_deployed", "= ring_pantograph 4 60"},
       {"parallelogram_grid", 2, 2, "parallelogram_grid R C",
@@ -97,8 +95,7 @@ const std::vector<FamilyInfo>& listFamilies() {
       {"chain", 1, 1, "chain N [--shape straight|zigzag] [--order root-first|leaf-first]",
        "open revolute chain of N links; planar DOF N G N R 0, spatial DOF N G N R 0"},
       {"star", 1, 1, "star N",
-       "hub on the ground carrying N arms, all revolute; planar DOF N+1 G N+1 R 0, spatial DOF N+1 G N+1 R "
-       "0"},
+       "hub on a ground pin carrying N arms on pins; planar DOF N+1 G N+1 R 0, spatial DOF N+1 G N+1 R 0"},
       {"ring", 1, 1, "ring N (N >= 3)",
        "one loop of N links on a circle, one grounded; planar DOF N-3 G N-3 R 0, spatial DOF N-3 G N-6 R 3"},
       {"bar_lattice", 2, 2, "bar_lattice R C",
