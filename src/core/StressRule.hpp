@@ -46,10 +46,12 @@ class StressRule {
     std::optional<SelfStress> stress;
     if (findsFirst(finder)) {
       stress = find();
-      if (stress)
+      if (stress) {
         ++locallyResolved;
-      else
+        futileFinds_ = 0;  // the failures counted are those in a row
+      } else {
         ++futileFinds_;
+      }
     }
     if (!stress) {
       stress = cappedTrace(traceLimit_);

@@ -564,6 +564,51 @@ TEST(SelfStressBasis, TheRuleFindsFirstOnceTracesKeepRunningPastTheirLimit) {
   EXPECT_FALSE(rule.findsFirst(finder));
 }
 
+TEST(SelfStressBasis, TheRuleKeepsFindingFirstPastScatteredFailures) {
+  // Where the balls in space have taken over, the find goes first until kFutileFinds searches have failed in
+  // a row. A failed row costs two (before and after its capped trace); a find that succeeds ends the run.
+  // Counted over the whole sweep instead, four failing rows anywhere among thousands of local ones stopped
+  // the search for every row after them, and those were traced in full (a grid of continuous bars in space).
+  const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath("four_bar.urdf")), AnalysisMode::Planar);
+  const EliminationOrder order = computeSweepOrder(m.mechanism, m.assembled.model);
+  std::vector<int> position(m.J.rows());
+  for (size_t i = 0; i < order.rows.size(); ++i)
+    position[order.rows[i]] = static_cast<int>(i);
+  core_detail::LocalStressFinder finder(m.mechanism, m.assembled.model, m.J, order, position,
+                                        tolerances::kRank);
+  finder.setState(core_detail::LocalStressFinder::State{1, 0.0, true});
+  ASSERT_TRUE(finder.inSpaceFirst());
+  const SelfStress local = {{0, 1.0}, {3, -0.5}}, traced = {{1, 1.0}, {2, 0.25}};
+  bool findSucceeds = true;
+  int traces = 0, locallyResolved = 0;
+  auto find = [&]() -> std::optional<SelfStress> {
+    return findSucceeds ? std::optional<SelfStress>(local) : std::nullopt;
+  };
+  auto cappedTrace = [&](size_t) -> std::optional<SelfStress> {
+    ++traces;
+    return std::nullopt;
+  };
+  auto fullTrace = [&] { return traced; };
+  core_detail::StressRule rule;
+  auto resolve = [&] { return rule.resolve(finder, find, cappedTrace, fullTrace, locallyResolved); };
+  for (int round = 0; round < 2 * core_detail::kFutileFinds; ++round) {
+    for (int row = 0; row < 3; ++row) {
+      ASSERT_TRUE(rule.findsFirst(finder)) << "round " << round;
+      EXPECT_EQ(resolve(), local);
+    }
+    findSucceeds = false;
+    EXPECT_EQ(resolve(), traced);  // found first, traced, found again: the full trace
+    findSucceeds = true;
+  }
+  EXPECT_TRUE(rule.findsFirst(finder));
+  EXPECT_EQ(traces, 2 * core_detail::kFutileFinds);  // the failing rows only
+  // Failures in a row still stop it.
+  findSucceeds = false;
+  for (int row = 0; row < core_detail::kFutileFinds / 2; ++row)
+    resolve();
+  EXPECT_FALSE(rule.findsFirst(finder));
+}
+
 TEST(SelfStressBasis, BracedLatticeWhereTheRuleFindsFirstGivesTheContractOrderAnswer) {
   // 36 x 36 cells: past the futile traces some rows are found first (the basis differs from the traced one),
   // and it must still be a basis with the contract-order elimination's answer. Closed form: 2RC - R - C + 1.
