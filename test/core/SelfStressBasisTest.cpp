@@ -504,17 +504,34 @@ TEST(SelfStressBasis, FindsMadeAheadGiveTheOneThreadBasisToTheBit) {
   }
 }
 
+namespace {
+
+/// Sweep positions of the rows of @p order.
+std::vector<int> positionsOf(const EliminationOrder& order) {
+  std::vector<int> position(order.rows.size());
+  for (size_t i = 0; i < order.rows.size(); ++i)
+    position[order.rows[i]] = static_cast<int>(i);
+  return position;
+}
+
+/// A four-bar's sweep and a finder over it, for the rule's tests (stand-ins do the finding; the rule reads
+/// only the finder's state). Built in place and not copied: the finder refers to the members before it.
+struct FourBarSweep {
+  ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath("four_bar.urdf")), AnalysisMode::Planar);
+  EliminationOrder order = computeSweepOrder(m.mechanism, m.assembled.model);
+  std::vector<int> position = positionsOf(order);
+  core_detail::LocalStressFinder finder{m.mechanism, m.assembled.model, m.J,
+                                        order,       position,          tolerances::kRank};
+};
+
+}  // namespace
+
 TEST(SelfStressBasis, TheRuleFindsFirstOnceTracesKeepRunningPastTheirLimit) {
   // The sweep's rule for a dependent row (StressRule), with stand-ins for the local find and the traces: a
   // trace that runs past its limit costs its limit's pivots and is dropped for the find, so after
   // kFutileTraces such rows in a row the find goes first, until a find fails.
-  const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath("four_bar.urdf")), AnalysisMode::Planar);
-  const EliminationOrder order = computeSweepOrder(m.mechanism, m.assembled.model);
-  std::vector<int> position(m.J.rows());
-  for (size_t i = 0; i < order.rows.size(); ++i)
-    position[order.rows[i]] = static_cast<int>(i);
-  const core_detail::LocalStressFinder finder(m.mechanism, m.assembled.model, m.J, order, position,
-                                              tolerances::kRank);
+  FourBarSweep sweep;
+  const core_detail::LocalStressFinder& finder = sweep.finder;
   ASSERT_FALSE(finder.inSpaceFirst());
   const SelfStress local = {{0, 1.0}, {3, -0.5}}, traced = {{1, 1.0}, {2, 0.25}};
   bool findSucceeds = true, traceSucceeds = false;
@@ -569,13 +586,8 @@ TEST(SelfStressBasis, TheRuleKeepsFindingFirstPastScatteredFailures) {
   // a row. A failed row costs two (before and after its capped trace); a find that succeeds ends the run.
   // Counted over the whole sweep instead, four failing rows anywhere among thousands of local ones stopped
   // the search for every row after them, and those were traced in full (a grid of continuous bars in space).
-  const ModelAtTreePose m = assembleAtTreePose(loadOrFail(urdfPath("four_bar.urdf")), AnalysisMode::Planar);
-  const EliminationOrder order = computeSweepOrder(m.mechanism, m.assembled.model);
-  std::vector<int> position(m.J.rows());
-  for (size_t i = 0; i < order.rows.size(); ++i)
-    position[order.rows[i]] = static_cast<int>(i);
-  core_detail::LocalStressFinder finder(m.mechanism, m.assembled.model, m.J, order, position,
-                                        tolerances::kRank);
+  FourBarSweep sweep;
+  core_detail::LocalStressFinder& finder = sweep.finder;
   finder.setState(core_detail::LocalStressFinder::State{1, 0.0, true});
   ASSERT_TRUE(finder.inSpaceFirst());
   const SelfStress local = {{0, 1.0}, {3, -0.5}}, traced = {{1, 1.0}, {2, 0.25}};
