@@ -41,6 +41,7 @@ class EquationPlaces {
       return x;
     };
     std::vector<int> seen;
+    std::vector<int> placedRow(mechanism.joints.size(), -1);  // per joint, its first located row
     for (int r = 0; r < J.rows(); ++r) {
       const ConstraintEquation& eq = model.equations[r];
       if (eq.source == EquationSource::Joint) {
@@ -59,6 +60,8 @@ class EquationPlaces {
         if (count > 0) {
           place_[r] = sum / count;
           located_[r] = 1;
+          if (placedRow[eq.element] < 0)
+            placedRow[eq.element] = r;
         }
       } else if (eq.source == EquationSource::Link && eq.form == EquationForm::Combination &&
                  model.elements[eq.target()].isPoint) {
@@ -93,7 +96,7 @@ class EquationPlaces {
     } else {
       spacing_ = model.characteristicLength > 0.0 ? model.characteristicLength : 1.0;
     }
-    locateAtJoints(model, J);
+    locateAtJoints(model, placedRow);
     // Located rows bucketed in cubes of the spacing.
     for (int r = 0; r < J.rows(); ++r) {
       if (located_[r] == 0)
@@ -162,27 +165,22 @@ class EquationPlaces {
    * grid of continuous bars pinned at every crossing, in spatial mode, a cell's stress between its four pins'
    * axes was traced along whole bars (a 50 x 50 grid: 12 387 of 12 400 stresses, up to 997 entries each)
    * or found in a ball holding every axis of its four bars (quadratic). Placed after the spacing is taken,
-   * which reads the links' point combinations only. A joint without a located row leaves them as they were:
-   * its own unplaced, a link's attached to the link.
+   * which reads the links' point combinations only. A joint without a located row (@p placedRow, per joint:
+   * its first located row, else -1) leaves them as they were: its own unplaced, a link's attached to the
+   * link.
    */
-  void locateAtJoints(const CoordinateModel& model, const SparseJacobian& J) {
-    std::unordered_map<int, int> placedRow;  // joint -> one of its located rows
-    for (int r = 0; r < J.rows(); ++r) {
-      const ConstraintEquation& eq = model.equations[r];
-      if (eq.source == EquationSource::Joint && located_[r] != 0)
-        placedRow.emplace(eq.element, r);
-    }
-    for (int r = 0; r < J.rows(); ++r) {
+  void locateAtJoints(const CoordinateModel& model, const std::vector<int>& placedRow) {
+    for (size_t r = 0; r < located_.size(); ++r) {
       const ConstraintEquation& eq = model.equations[r];
       if (located_[r] != 0 || !atJointWithoutPoint(model, eq))
         continue;
       const int joint = eq.source == EquationSource::Joint ? eq.element : model.elements[eq.target()].joint;
-      const auto placed = placedRow.find(joint);
-      if (placed != placedRow.end()) {
-        place_[r] = place_[placed->second];
+      const int placed = placedRow[static_cast<size_t>(joint)];
+      if (placed >= 0) {
+        place_[r] = place_[static_cast<size_t>(placed)];
         located_[r] = 1;
       } else if (eq.source == EquationSource::Link) {
-        attached_[eq.element].push_back(r);
+        attached_[eq.element].push_back(static_cast<int>(r));
       }
     }
   }
