@@ -25,6 +25,13 @@ namespace mobility_analysis {
  * its two parallel prismatic joints. passive_dof is the dimension of the span of all such motions (each a
  * first-order motion of the whole mechanism that is also finite), so output_dof = finite_dof − passive_dof
  * counts the freedoms that move something outside an idle group.
+ *
+ * The span is taken whole, not group by group: along a chain the groups are searched from one end, each after
+ * the groups it contains, and a motion is kept when it adds a dimension to every motion kept before, whichever
+ * links those move (a pair of rods turning about the line of both is the sum of their spins). Motions are
+ * compared in the units of their own links (a point's velocity divided by its link's length), so small links
+ * in a large mechanism are judged as in a small one. The motions kept are listed by group, in the groups'
+ * sorted order.
  */
 struct PassiveFreedoms {
   int dof = 0;

@@ -12,6 +12,7 @@
 
 #include "../Buckets.hpp"
 #include "../LocalRows.hpp"
+#include "MotionSpan.hpp"
 #include "mobility_analysis/coordinates/EquationForms.hpp"
 
 namespace mobility_analysis {
@@ -24,6 +25,9 @@ constexpr double kTwistNullity = 1e-8;
 constexpr double kFiniteStep = 0.05;
 /// ... and accepts the motion when no constraint moves more than this [normalised length].
 constexpr double kFiniteResidual = 1e-9;
+/// A motion (at unit norm) whose remainder off the span of the motions kept is at most this adds no
+/// dimension to it (MotionSpan); the column-pivoted QR that compared motions before used the same threshold.
+constexpr double kMotionIndependence = 1e-6;
 /// Most rigid bodies an idle group may be: links joined by welds (fixed connections) count as one, so a rod
 /// written as two halves, each with its closure frame, welded at the middle (Gepetto's cut rods) is one.
 constexpr size_t kMaxGroup = 3;
@@ -518,18 +522,124 @@ CandidateGroups findCandidateGroups(const SearchContext& context, const EndConne
   return candidates;
 }
 
-/// The search of the candidate groups, in their order: a group's null twists, the finite check of each, and
-/// the comparison with the motions kept so far.
+/// Each link's position along the chains of links with two connections (the ground excepted), the links
+/// idle groups are made of: a group's links lie at consecutive positions (or wrap around a ring of such
+/// links, which is reduced last); -1 for every other link.
+std::vector<int> chainPositions(const SearchContext& context) {
+  const int root = context.mechanism.rootLink;
+  auto inChain = [&](int l) { return l != root && context.connectionsAt(l).size() == 2; };
+  std::vector<int> position(static_cast<size_t>(context.numLinks), -1);
+  int next = 0;
+  for (int l = 0; l < context.numLinks; ++l) {
+    if (!inChain(l) || position[static_cast<size_t>(l)] >= 0)
+      continue;
+    // Back to one end of l's chain (on a ring: round to the link before l).
+    int end = l, previous = -1;
+    for (int steps = 0; steps < context.numLinks; ++steps) {
+      const core_detail::BucketRange connections = context.connectionsAt(end);
+      const int a = context.otherLink(connections[0], end), b = context.otherLink(connections[1], end);
+      const int towards = a != previous ? a : b;
+      if (towards == previous || towards == l || !inChain(towards))
+        break;
+      previous = end;
+      end = towards;
+    }
+    // Then along the chain from that end, numbering.
+    for (int at = end; at >= 0;) {
+      position[static_cast<size_t>(at)] = next++;
+      int following = -1;
+      for (int j : context.connectionsAt(at)) {
+        const int other = context.otherLink(j, at);
+        if (inChain(other) && position[static_cast<size_t>(other)] < 0) {
+          following = other;
+          break;
+        }
+      }
+      at = following;
+    }
+  }
+  return position;
+}
+
+/// Where MotionSpan reads each coordinate: its position along the chains, and the factor its entries are
+/// taken at.
+struct CoordinateLayout {
+  std::vector<int> position;  ///< The least position of the links whose elements hold it (-1: none).
+  /// A point's coordinates are divided by the length of the link at that position (the largest distance of
+  /// its points from its first), a unit vector's taken as they are: a motion is compared in the units of its
+  /// own links, rad for a turn. In the model's units (lengths in Lc) the ball-jointed rods of a ring 64 m
+  /// across, 0.1 m long each, move their points 600 times less than their directions: two rods nearly in
+  /// line, turned as a pair about their end balls, differed from their two spins by 1e-6, the tolerance.
+  std::vector<double> scale;
+};
+
+CoordinateLayout coordinateLayout(const SearchContext& context, const std::vector<int>& linkPosition) {
+  const CoordinateModel& model = context.model;
+  const size_t numCoordinates = static_cast<size_t>(model.numCoordinates());
+  CoordinateLayout layout{std::vector<int>(numCoordinates, -1), std::vector<double>(numCoordinates, 1.0)};
+  for (size_t l = 0; l < linkPosition.size() && l < model.bodyElements.size(); ++l) {
+    const int at = linkPosition[l];
+    if (at < 0)
+      continue;
+    double length = 0.0;
+    for (int e : model.bodyElements[l]) {
+      if (model.elements[e].isPoint)
+        length = std::max(length, (context.element3(e) - context.twistOrigin(static_cast<int>(l))).norm());
+    }
+    for (int e : model.bodyElements[l]) {
+      for (int k = 0; k < context.dim; ++k) {
+        const size_t c = static_cast<size_t>(model.elements[e].offset + k);
+        if (layout.position[c] >= 0 && layout.position[c] < at)
+          continue;  // held by a link before this one: read at its position, in its length
+        layout.position[c] = at;
+        layout.scale[c] = model.elements[e].isPoint && length > 0.0 ? 1.0 / length : 1.0;
+      }
+    }
+  }
+  return layout;
+}
+
+/// The order the groups are searched in: by the last position of their links, then the shorter first (a
+/// group after every group it contains, and MotionSpan's rows end by the position of the motion it reduces).
+std::vector<size_t> searchOrder(const std::vector<Group>& groups, const std::vector<int>& linkPosition) {
+  struct Key {
+    int last, first;
+    size_t index;
+  };
+  std::vector<Key> keys;
+  keys.reserve(groups.size());
+  for (size_t g = 0; g < groups.size(); ++g) {
+    Key key{-1, std::numeric_limits<int>::max(), g};
+    for (int l : groups[g]) {
+      if (l < 0)
+        break;
+      key.last = std::max(key.last, linkPosition[static_cast<size_t>(l)]);
+      key.first = std::min(key.first, linkPosition[static_cast<size_t>(l)]);
+    }
+    keys.push_back(key);
+  }
+  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+    return a.last != b.last ? a.last < b.last : a.first != b.first ? a.first > b.first : a.index < b.index;
+  });
+  std::vector<size_t> order;
+  order.reserve(keys.size());
+  for (const Key& key : keys)
+    order.push_back(key.index);
+  return order;
+}
+
+/// The search of the candidate groups: a group's null twists, the finite check of each, and whether it adds
+/// a dimension to the span of the motions kept so far.
 class GroupSearch {
  public:
-  explicit GroupSearch(const SearchContext& context);
+  GroupSearch(const SearchContext& context, CoordinateLayout layout);
 
   /// Searches the group @p padded: counts it in @p result if it qualifies and appends its new motions.
   void search(const Group& padded, PassiveFreedoms& result);
 
  private:
   /// A motion as (coordinate, value) over its group's coordinates.
-  using Motion = std::vector<std::pair<int, double>>;
+  using Motion = core_detail::SparseMotion;
 
   void searchMarked(PassiveFreedoms& result);
   bool hasTwoEndsToTwoLinks();
@@ -540,8 +650,6 @@ class GroupSearch {
   void clearLocalColumns();
   void searchNullTwists(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A, PassiveFreedoms& result);
   bool movesFinitely(const Eigen::Vector3d& omega, const Eigen::Vector3d& v);
-  bool isIndependent(const Motion& motion);
-  void accept(Motion motion);
   PassiveMotion describe(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) const;
   std::string endsPhrase() const;
 
@@ -550,11 +658,10 @@ class GroupSearch {
   Eigen::SparseMatrix<double> Jc_;
   bool haveColumns_ = false;
   std::vector<char> inGroup_;
-  // Motions kept, and the motions at each link: a group is compared with those sharing one of its links
-  // only, and nothing here costs more than the group's neighbourhood (a chain of 10^5 links has 3 10^5
-  // candidate groups).
-  std::vector<Motion> accepted_;
-  std::vector<std::vector<int>> acceptedAt_;
+  // The span of the motions kept (a chain of 10^5 links has 3 10^5 candidate groups: a new motion is
+  // reduced within its own chain only).
+  std::vector<double> scale_;  // CoordinateLayout::scale
+  core_detail::MotionSpan span_;
   std::vector<int> localColumn_;
   Eigen::VectorXd moved_;  // q, copied when a first twist is stepped
   // Work space of one group, reused (a chain of 10^5 links has 3 10^5 groups: no allocation per group).
@@ -563,10 +670,11 @@ class GroupSearch {
   Eigen::Vector3d about_ = Eigen::Vector3d::Zero();  // the point the group's twists are about
 };
 
-GroupSearch::GroupSearch(const SearchContext& context)
+GroupSearch::GroupSearch(const SearchContext& context, CoordinateLayout layout)
     : context_(context),
       inGroup_(context.numLinks, 0),
-      acceptedAt_(context.numLinks),
+      scale_(std::move(layout.scale)),
+      span_(std::move(layout.position), kMotionIndependence),
       localColumn_(context.model.numCoordinates(), -1) {}
 
 void GroupSearch::search(const Group& padded, PassiveFreedoms& result) {
@@ -723,10 +831,10 @@ void GroupSearch::searchNullTwists(const Eigen::MatrixXd& T, const Eigen::Matrix
     Motion motion;
     const Eigen::VectorXd local = T * xi;
     for (size_t c = 0; c < columns_.size(); ++c)
-      motion.emplace_back(columns_[c], local(static_cast<Eigen::Index>(c)));
-    if (!isIndependent(motion))
+      motion.emplace_back(columns_[c],
+                          scale_[static_cast<size_t>(columns_[c])] * local(static_cast<Eigen::Index>(c)));
+    if (!span_.addIfIndependent(motion))
       continue;
-    accept(std::move(motion));
     result.motions.push_back(describe(omega, v));
   }
 }
@@ -759,56 +867,6 @@ bool GroupSearch::movesFinitely(const Eigen::Vector3d& omega, const Eigen::Vecto
   for (int e : elements_)
     moved_.segment(model.elements[e].offset, dim) = context_.q.segment(model.elements[e].offset, dim);
   return !(change > kFiniteResidual);
-}
-
-/// Independent of the motions already kept (only those sharing a link can be dependent), compared over the
-/// coordinates they move (every other coordinate is zero in all of them).
-bool GroupSearch::isIndependent(const Motion& motion) {
-  std::vector<int> overlapping;
-  for (int l : group_) {
-    for (int a : acceptedAt_[l]) {
-      if (std::find(overlapping.begin(), overlapping.end(), a) == overlapping.end())
-        overlapping.push_back(a);
-    }
-  }
-  std::sort(overlapping.begin(), overlapping.end());
-  if (overlapping.empty())
-    return true;
-  std::vector<int> support;
-  auto columnOf = [&](int coordinate) {
-    if (localColumn_[coordinate] < 0) {
-      localColumn_[coordinate] = static_cast<int>(support.size());
-      support.push_back(coordinate);
-    }
-    return localColumn_[coordinate];
-  };
-  for (int a : overlapping) {
-    for (const auto& entry : accepted_[a])
-      columnOf(entry.first);
-  }
-  for (const auto& entry : motion)
-    columnOf(entry.first);
-  Eigen::MatrixXd stack = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(support.size()),
-                                                static_cast<Eigen::Index>(overlapping.size()) + 1);
-  auto fill = [&](const Motion& vector, Eigen::Index column) {
-    for (const auto& [coordinate, value] : vector)
-      stack(localColumn_[coordinate], column) = value;
-    stack.col(column).normalize();
-  };
-  for (size_t a = 0; a < overlapping.size(); ++a)
-    fill(accepted_[overlapping[a]], static_cast<Eigen::Index>(a));
-  fill(motion, stack.cols() - 1);
-  for (int coordinate : support)
-    localColumn_[coordinate] = -1;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(stack);
-  qr.setThreshold(1e-6);
-  return qr.rank() >= stack.cols();
-}
-
-void GroupSearch::accept(Motion motion) {
-  for (int l : group_)
-    acceptedAt_[l].push_back(static_cast<int>(accepted_.size()));
-  accepted_.push_back(std::move(motion));
 }
 
 /// The phrase: the group, what it does, and the connections it turns or slides between.
@@ -871,9 +929,24 @@ PassiveFreedoms findPassiveFreedoms(const Mechanism& mechanism, const Coordinate
   result.groupsRigidByEnds = candidates.rigidByEnds;
   if (candidates.groups.empty())
     return result;
-  GroupSearch search(context);
-  for (const Group& group : candidates.groups)
-    search.search(group, result);
+  const std::vector<int> linkPosition = chainPositions(context);
+  GroupSearch search(context, coordinateLayout(context, linkPosition));
+  // Searched in chain order (MotionSpan), listed in the groups' sorted order, each group's motions together.
+  std::vector<size_t> groupOfMotion;
+  for (size_t g : searchOrder(candidates.groups, linkPosition)) {
+    search.search(candidates.groups[g], result);
+    groupOfMotion.resize(result.motions.size(), g);
+  }
+  std::vector<size_t> listed(result.motions.size());
+  for (size_t m = 0; m < listed.size(); ++m)
+    listed[m] = m;
+  std::stable_sort(listed.begin(), listed.end(),
+                   [&](size_t a, size_t b) { return groupOfMotion[a] < groupOfMotion[b]; });
+  std::vector<PassiveMotion> motions;
+  motions.reserve(listed.size());
+  for (size_t m : listed)
+    motions.push_back(std::move(result.motions[m]));
+  result.motions = std::move(motions);
   result.dof = static_cast<int>(result.motions.size());
   return result;
 }
