@@ -365,8 +365,21 @@ TEST(PassiveFreedoms, EveryIdleMotionOfAChainCountsOnceWhicheverGroupShowsIt) {
   }
   // Listed from the simplest groups: on the straight rope, the rods' own spins.
   const MobilityReport rope = analyze(cases[0].urdf);
-  for (const PassiveMotion& motion : rope.passiveMotions)
+  for (const PassiveMotion& motion : rope.passiveMotions) {
     EXPECT_EQ(motion.links.size(), 1u) << motion.description;
+    EXPECT_NE(motion.description.find("spins about the line through its ball joints"), std::string::npos);
+  }
+  // A planar-jointed link turns about the plane's normal, which passes through neither joint point (the
+  // joints are at 0.1 m spacing along x): no phrase may claim the line through its joints.
+  const MobilityReport planar = analyze(cases[2].urdf);
+  int turns = 0;
+  for (const PassiveMotion& motion : planar.passiveMotions) {
+    const bool turn = motion.description.find(" turns about an axis along (0, 0, ") != std::string::npos;
+    const bool slide = motion.description.find(" slides along ") != std::string::npos;
+    EXPECT_TRUE(turn || slide) << motion.description;
+    turns += turn ? 1 : 0;
+  }
+  EXPECT_GE(turns, 1);
 }
 
 TEST(PassiveFreedoms, SmallRodsInALargeMechanismAreComparedInTheirOwnLength) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <set>
@@ -28,6 +29,8 @@ constexpr double kFiniteResidual = 1e-9;
 /// A motion (at unit norm) whose remainder off the span of the motions kept is at most this adds no
 /// dimension to it (MotionSpan); the column-pivoted QR that compared motions before used the same threshold.
 constexpr double kMotionIndependence = 1e-6;
+/// A point lies on a line, and two unit directions are parallel, within this [Lc, or -] (the phrases only).
+constexpr double kLineTolerance = 1e-6;
 /// Most rigid bodies an idle group may be: links joined by welds (fixed connections) count as one, so a rod
 /// written as two halves, each with its closure frame, welded at the middle (Gepetto's cut rods) is one.
 constexpr size_t kMaxGroup = 3;
@@ -628,6 +631,18 @@ std::vector<size_t> searchOrder(const std::vector<Group>& groups, const std::vec
   return order;
 }
 
+/// "(0, 0.707, -0.707)": a unit direction, three digits, rounding noise shown as 0.
+std::string directionText(const Eigen::Vector3d& direction) {
+  std::string text = "(";
+  for (int k = 0; k < 3; ++k) {
+    char buffer[32];
+    const double x = std::abs(direction(k)) < 1e-9 ? 0.0 : direction(k);
+    std::snprintf(buffer, sizeof(buffer), "%.3g", x);
+    text += (k == 0 ? "" : ", ") + std::string(buffer);
+  }
+  return text + ")";
+}
+
 /// The search of the candidate groups: a group's null twists, the finite check of each, and whether it adds
 /// a dimension to the span of the motions kept so far.
 class GroupSearch {
@@ -651,6 +666,9 @@ class GroupSearch {
   void searchNullTwists(const Eigen::MatrixXd& T, const Eigen::MatrixXd& A, PassiveFreedoms& result);
   bool movesFinitely(const Eigen::Vector3d& omega, const Eigen::Vector3d& v);
   PassiveMotion describe(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) const;
+  bool endsOnLine(const Eigen::Vector3d& point, const Eigen::Vector3d& direction) const;
+  bool alongEnds(const Eigen::Vector3d& direction) const;
+  bool isEnd(int j) const;
   std::string endsPhrase() const;
 
   const SearchContext& context_;
@@ -880,13 +898,68 @@ PassiveMotion GroupSearch::describe(const Eigen::Vector3d& omega, const Eigen::V
   const std::string ends = endsPhrase();
   const std::string subject = (group_.size() == 1 ? "link " : "chain ") + names;
   if (omega.norm() < 1e-9 * v.norm()) {
-    passive.description = subject + " slides along the line of its " + ends;
-  } else if (std::abs(omega.normalized().dot(v)) > 1e-6 * v.norm() + 1e-12) {
-    passive.description = subject + " screws about the line of its " + ends;
-  } else {
-    passive.description = subject + " spins about the line through its " + ends;
+    const Eigen::Vector3d direction = v.normalized();
+    passive.description =
+        alongEnds(direction) ? subject + " slides along the line of its " + ends
+                             : subject + " slides along " + directionText(direction) + " between its " + ends;
+    return passive;
   }
+  // The twist's axis: the points moving along it, about_ + omega x v / |omega|^2 (Murray, Li & Sastry §2.2).
+  const Eigen::Vector3d axis = omega.normalized(), through = about_ + omega.cross(v) / omega.squaredNorm();
+  const bool screws = std::abs(axis.dot(v)) > 1e-6 * v.norm() + 1e-12;
+  if (endsOnLine(through, axis))
+    passive.description =
+        subject + (screws ? " screws about the line of its " : " spins about the line through its ") + ends;
+  else
+    passive.description = subject + (screws ? " screws" : " turns") + " about an axis along " +
+                          directionText(axis) + " between its " + ends;
   return passive;
+}
+
+/// Whether the group's end connections, at their points on the group, lie on the line through @p point
+/// along the unit @p direction (lengths in Lc; a connection with no point there, such as a planar joint's,
+/// does not).
+bool GroupSearch::endsOnLine(const Eigen::Vector3d& point, const Eigen::Vector3d& direction) const {
+  int found = 0;
+  for (int e : elements_) {
+    const Element& element = context_.model.elements[e];
+    if (element.role != ElementRole::JointPoint || !isEnd(element.joint))
+      continue;
+    if ((context_.element3(e) - point).cross(direction).norm() > kLineTolerance)
+      return false;
+    ++found;
+  }
+  return found >= 2;
+}
+
+/// Whether @p direction (a unit slide) is the line of the group's ends: parallel to the axes the end
+/// connections have on the group (two parallel prismatic joints), or to the line through their points.
+bool GroupSearch::alongEnds(const Eigen::Vector3d& direction) const {
+  std::vector<Eigen::Vector3d> points;
+  bool axes = false, parallel = true;
+  for (int e : elements_) {
+    const Element& element = context_.model.elements[e];
+    if (!isEnd(element.joint))
+      continue;
+    if (element.role == ElementRole::JointPoint) {
+      points.push_back(context_.element3(e));
+    } else if (element.role == ElementRole::JointAxis) {
+      axes = true;
+      parallel = parallel && context_.element3(e).cross(direction).norm() <= kLineTolerance;
+    }
+  }
+  if (axes && parallel)
+    return true;
+  return points.size() == 2 && (points[1] - points[0]).norm() > kLineTolerance &&
+         (points[1] - points[0]).normalized().cross(direction).norm() <= kLineTolerance;
+}
+
+/// Whether connection @p j (an element's joint, -1 for none) is one of the group's end connections.
+bool GroupSearch::isEnd(int j) const {
+  if (j < 0)
+    return false;
+  const std::pair<int, int>& ends = context_.jointEnds[static_cast<size_t>(j)];
+  return inGroup_[ends.first] != inGroup_[ends.second];
 }
 
 /// The group's end connections, "revolute joints j1 and j2" (their kind named when they share one).
