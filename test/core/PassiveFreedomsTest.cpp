@@ -302,7 +302,9 @@ std::string serialChainUrdf(int n, const std::string& type, const std::string& r
     urdf += "<link name='l" + std::to_string(i) + "'/><" + tag + " name='j" + std::to_string(i) + "' type='" +
             type + "'><parent link='" + (i == 0 ? std::string("ground") : "l" + std::to_string(i - 1)) +
             "'/><child link='l" + std::to_string(i) + "'/><origin xyz='0.1 0 0' rpy='" + rpy +
-            "'/><axis xyz='0 0 1'/></" + tag + ">";
+            "'/><axis xyz='0 0 1'/>" +
+            (type == "prismatic" ? "<limit lower='-1' upper='1' effort='1' velocity='1'/>" : "") + "</" +
+            tag + ">";
   }
   return urdf + "</robot>";
 }
@@ -342,7 +344,9 @@ TEST(PassiveFreedoms, EveryIdleMotionOfAChainCountsOnceWhicheverGroupShowsIt) {
   //  - a helical rope: 3 n - 6, every motion of rods l0..l(n-2) between the ground and l(n-1) held still
   //    (3 (n - 1) freedoms less the 3 of l(n-1)'s ball), each a sum of single, pair and triple motions;
   //  - a chain of planar joints in space (all normals z): 3 (n - 1), each link but the last sliding and
-  //    turning in its plane between its two neighbours.
+  //    turning in its plane between its two neighbours;
+  //  - a telescope (prismatic joints, all along z): n - 1, each stage but the last sliding between its
+  //    neighbours; its one output is the last stage's slide (before: n passive, 0 output).
   // Compared only with the motions sharing one of its links (as before), the straight rope of 6 rods counted
   // 10, the rope of 200 rods 495, and the planar chain of 6 links 30 motions (reported as 18, the whole DOF).
   struct Case {
@@ -354,6 +358,7 @@ TEST(PassiveFreedoms, EveryIdleMotionOfAChainCountsOnceWhicheverGroupShowsIt) {
       {"straight rope", serialChainUrdf(n, "ball", "0 0 0", true), 3 * n, n - 1},
       {"helical rope", serialChainUrdf(n, "ball", "0.3 0.2 0.7", true), 3 * n, 3 * n - 6},
       {"planar chain", serialChainUrdf(n, "planar", "0 0 0", false), 3 * n, 3 * (n - 1)},
+      {"telescope", serialChainUrdf(n, "prismatic", "0 0 0", false), n, n - 1},
       {"long straight rope", serialChainUrdf(200, "ball", "0 0 0", true), 600, 199},
   };
   for (const Case& c : cases) {
