@@ -136,9 +136,13 @@ void reduceToContractOrder(const Mechanism& mechanism, const CoordinateModel& mo
  * @param[in] basis the self-stresses of the Jacobian (any basis gives the same answer).
  * @param[in] tolerance threshold for a row of Y (stresses scaled to unit largest coefficient) to be
  * independent of the rows after it.
+ * @param[in] limited give up when the reduction fills past the budget computeSelfStressBasis holds its own
+ * reduction to (a reduction computeSelfStressBasis made is read as it is).
  * @return The ordered rank in contract order (no dependencies), or nothing when the reduction found fewer
- *         pivots than the basis has stresses (a numerically ambiguous basis: use computeOrderedRank).
+ *         pivots than the basis has stresses (a numerically ambiguous basis) or, @p limited, passed its
+ *         budget: use computeOrderedRank.
  */
-std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis& basis, double tolerance);
+std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis& basis, double tolerance,
+                                                          bool limited = false);
 
 }  // namespace mobility_analysis

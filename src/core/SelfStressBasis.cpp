@@ -413,7 +413,8 @@ SelfStressBasis computeSelfStressBasis(const Mechanism& mechanism, const Coordin
   return basis;
 }
 
-std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis& basis, double tolerance) {
+std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis& basis, double tolerance,
+                                                          bool limited) {
   const int m = basis.numConstraints;
   const int n = basis.numCoordinates;
   OrderedRank result;
@@ -433,7 +434,7 @@ std::optional<OrderedRank> computeOrderedRankFromStresses(const SelfStressBasis&
     // The reduction computeSelfStressBasis made (within its budget, so the same as an unbounded one).
     const bool made = !echelon && basis.echelon && basis.echelon->tolerance == tolerance;
     const std::optional<StressEchelon> reduction =
-        made ? basis.echelon : reduceStresses(stresses, m, tolerance, false);
+        made ? basis.echelon : reduceStresses(stresses, m, tolerance, limited);
     if (!reduction || reduction->rank != static_cast<int>(stresses.size()))
       return std::nullopt;
     for (int r = 0; r < m; ++r)
