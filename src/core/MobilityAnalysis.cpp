@@ -142,11 +142,12 @@ Result<MobilityAnalysis> analyzeAssembled(const Mechanism& mechanism, const Anal
   progress("ordered redundancy", 0.8);
   // When the basis is numerically ambiguous, or its reduction to contract order fills past its budget, the
   // lecture's test itself in contract order decides (strict partial pivoting, near-tolerance rows re-checked
-  // by their orthogonal distance: RedundancyAnalysis.hpp). Why the budget: a strip of the continuous-bar grid
-  // (2 x 5 000 cells) has stresses with last equations of their own, which reduceToContractOrder leaves as
-  // they are, and their reduction took 0.9 s and 240 MB of fill where J's own elimination stores 2.3 times
-  // J's entries (the whole report 1.3 s -> 0.43 s; the same redundant equations, the margins of the other
-  // method's decisions).
+  // by their orthogonal distance: RedundancyAnalysis.hpp). Why the budget: on a strip of the continuous-bar
+  // grid (2 x 5 000 cells) the stresses share last equations, their reduction passes its budget in
+  // reduceToContractOrder, and no patch of links finds a contract-order echelon (the long bars put every pin
+  // in one ball); the reduction made again without a limit took 0.9 s and 240 MB of fill, where J's own
+  // elimination stores 2.3 times J's entries (the whole report 1.3 s -> 0.43 s; the same redundant
+  // equations, the margins of the other method's decisions).
   std::optional<OrderedRank> fromStresses = computeOrderedRankFromStresses(basis, tolerance, true);
   const bool decidedByJ = !fromStresses.has_value();
   const OrderedRank ranks = fromStresses ? std::move(*fromStresses) : computeOrderedRank(J, tolerance, false);

@@ -13,9 +13,8 @@ MotionSpan::MotionSpan(std::vector<int> positionOf, double tolerance)
       work_(positionOf_.size(), 0.0),
       touched_(positionOf_.size(), 0) {
   int last = -1;
-  for (int& p : positionOf_) {
+  for (const int p : positionOf_)
     last = std::max(last, p);
-  }
   // A coordinate without a position (none is ever moved) is reduced last, at a position of its own.
   for (int& p : positionOf_) {
     if (p < 0)
