@@ -27,6 +27,9 @@ struct OrderedRank {
   /// Decisions within tolerances::kNearDecisionFactor of the threshold that no orthogonal re-check settled
   /// (EliminationOptions::recheckNearTolerance): the answer may depend on rounding there.
   int uncheckedNearDecisions = 0;
+  /// Pivot rows subtracted over all the reductions (SparseElimination::reductionSteps; 0 from the dense and
+  /// stress-based methods): the elimination's work.
+  size_t reductionSteps = 0;
   int dof() const { return numCoordinates - rank; }
 };
 

@@ -128,6 +128,9 @@ class SparseElimination {
   double largestDroppedResidual() const { return largestDropped_; }
   /// Entries kept so far, of the pivot rows and their multipliers: the fill, which the time follows.
   size_t storedEntries() const { return entries_.size() + pivotMultipliers_.size(); }
+  /// Pivot rows subtracted over every reduction so far: the work, where a row is reduced through a chain of
+  /// pivot rows that each bring in the next (no fill, but time).
+  size_t reductionSteps() const { return reductionSteps_; }
 
  private:
   int priority(int column) const { return columnPriority_.empty() ? column : columnPriority_[column]; }
@@ -214,6 +217,7 @@ class SparseElimination {
   double smallestKept_ = -1.0;
   double largestDropped_ = 0.0;
   int reducedRow_ = -1;         ///< The row the workspace holds reduced (reduce).
+  size_t reductionSteps_ = 0;
   double reducedLargest_ = 0.0;  ///< Its largest entry in magnitude.
 };
 

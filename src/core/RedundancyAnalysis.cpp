@@ -88,6 +88,7 @@ OrderedRank computeSparseElimination(const SparseJacobian& J, double tolerance,
     result.nullityTrace[position] = n - elimination.rank();
   }
   result.rank = elimination.rank();
+  result.reductionSteps = elimination.reductionSteps();
   result.smallestKeptPivot = smallestKept < 0.0 ? 0.0 : smallestKept;
   result.largestDroppedResidual = largestDropped;
   return result;
@@ -98,6 +99,17 @@ OrderedRank computeOrderedRank(const SparseJacobian& J, double tolerance, bool c
   options.computeDependencies = computeDependencies;
   options.pivotThreshold = 1.0;
   options.recheckNearTolerance = true;
+  // Between entries of equal magnitude (exact ties are common where the equations are axis-aligned) the later
+  // coordinate: a child link's come after its parent's, so a joint's equations pivot on the child and leave
+  // the parent's free for its other joints (as ContractEchelon's patches take their columns). Which of equal
+  // entries is taken leaves the pivots' bound (|multiplier| <= 1) as it is. Measured on a strip of the
+  // continuous-bar grid in space (2 x 5 000 cells): with the earlier coordinate every third-row pin's reduced
+  // row pivoted on a long bar's basis, each pivot row led to the previous pin's, and each later row was
+  // reduced along the whole strip: 4.7 s, quadratic; now 0.04 s. The answers and margins of the families and
+  // bundled mechanisms measured are otherwise the same or within rounding.
+  options.columnPriority.resize(static_cast<size_t>(J.cols()));
+  for (Eigen::Index c = 0; c < J.cols(); ++c)
+    options.columnPriority[static_cast<size_t>(c)] = static_cast<int>(J.cols() - 1 - c);
   return computeSparseElimination(J, tolerance, options);
 }
 

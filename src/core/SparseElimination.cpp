@@ -96,6 +96,7 @@ SparseElimination::Step SparseElimination::reduceOver(const SparseJacobian& J, i
     }
     const double multiplier = value / pivot_[k];
     multipliers_.emplace_back(k, multiplier);
+    ++reductionSteps_;
     for (size_t i = entryStart_[k]; i < entryStart_[k + 1]; ++i) {
       const auto [column, entry] = entries_[i];
       add(column, -multiplier * entry, k);
@@ -174,6 +175,7 @@ void SparseElimination::reset(int numColumns) {
   touched_.clear();
   multipliers_.clear();
   smallestKept_ = -1.0;
+  reductionSteps_ = 0;
   largestDropped_ = 0.0;
   reducedRow_ = -1;
 }
