@@ -23,7 +23,8 @@ MotionSpan::MotionSpan(std::vector<int> positionOf, double tolerance)
   leadingAt_.resize(static_cast<size_t>(last) + 2);
 }
 
-bool MotionSpan::addIfIndependent(const SparseMotion& motion) {
+bool MotionSpan::isIndependent(const SparseMotion& motion) {
+  clearWork();  // a motion held and not kept
   double norm2 = 0.0;
   for (const auto& entry : motion)
     norm2 += entry.second * entry.second;
@@ -46,8 +47,7 @@ bool MotionSpan::addIfIndependent(const SparseMotion& motion) {
     project(position);
     const double remainder = normAt(position);
     if (remainder > tolerance_) {
-      keepRow(position);
-      clearWork();
+      heldPosition_ = position;
       return true;
     }
     for (int c : support_) {  // within the tolerance: zero here, and on to the next position
@@ -110,7 +110,15 @@ void MotionSpan::keepRow(int position) {
   rowStart_.push_back(entries_.size());
 }
 
+void MotionSpan::keep() {
+  if (heldPosition_ < 0)
+    return;
+  keepRow(heldPosition_);
+  clearWork();
+}
+
 void MotionSpan::clearWork() {
+  heldPosition_ = -1;
   for (int c : support_) {
     work_[static_cast<size_t>(c)] = 0.0;
     touched_[static_cast<size_t>(c)] = 0;

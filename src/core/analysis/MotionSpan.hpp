@@ -39,8 +39,18 @@ class MotionSpan {
   /// @param tolerance a remainder (the vector at unit norm) at most this is zero.
   MotionSpan(std::vector<int> positionOf, double tolerance);
 
+  /// Reduces @p motion against the rows kept; @return whether it is independent of them. Its reduced form is
+  /// held until keep() adds it or the next call drops it.
+  bool isIndependent(const SparseMotion& motion);
+  /// Adds the motion the last isIndependent found independent.
+  void keep();
   /// Adds @p motion when it is independent of the rows kept; @return whether it was.
-  bool addIfIndependent(const SparseMotion& motion);
+  bool addIfIndependent(const SparseMotion& motion) {
+    if (!isIndependent(motion))
+      return false;
+    keep();
+    return true;
+  }
 
   int dimension() const { return static_cast<int>(rowStart_.size()) - 1; }
 
@@ -64,6 +74,7 @@ class MotionSpan {
   std::vector<char> touched_;
   std::vector<int> support_;
   std::vector<int> pending_;
+  int heldPosition_ = -1;  // where the held independent motion leads (-1: none held)
 };
 
 }  // namespace core_detail

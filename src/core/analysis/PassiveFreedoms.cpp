@@ -844,15 +844,16 @@ void GroupSearch::searchNullTwists(const Eigen::MatrixXd& T, const Eigen::Matrix
       omega = xi.head<3>();
       v = xi.tail<3>();
     }
-    if (!movesFinitely(omega, v))
-      continue;
+    // A motion in the span of those kept adds nothing whether or not it is finite: that is decided first,
+    // the finite step (the costlier check) only for a motion that would add a dimension.
     Motion motion;
     const Eigen::VectorXd local = T * xi;
     for (size_t c = 0; c < columns_.size(); ++c)
       motion.emplace_back(columns_[c],
                           scale_[static_cast<size_t>(columns_[c])] * local(static_cast<Eigen::Index>(c)));
-    if (!span_.addIfIndependent(motion))
+    if (!span_.isIndependent(motion) || !movesFinitely(omega, v))
       continue;
+    span_.keep();
     result.motions.push_back(describe(omega, v));
   }
 }
