@@ -21,6 +21,7 @@ MotionSpan::MotionSpan(std::vector<int> positionOf, double tolerance)
       p = last + 1;
   }
   leadingAt_.resize(static_cast<size_t>(last) + 2);
+  queued_.assign(leadingAt_.size(), 0);
 }
 
 bool MotionSpan::isIndependent(const SparseMotion& motion) {
@@ -39,8 +40,7 @@ bool MotionSpan::isIndependent(const SparseMotion& motion) {
     std::pop_heap(pending_.begin(), pending_.end(), std::greater<int>());
     const int position = pending_.back();
     pending_.pop_back();
-    if (!pending_.empty() && pending_.front() == position)
-      continue;  // queued more than once: reduced when the last copy comes off
+    current_ = position;  // a projection here touches coordinates here and after only: none is queued again
     // Twice: the second projection removes what rounding left of the first (Giraud et al. 2005, "twice is
     // enough"), so that the rows leading here stay orthonormal to working precision.
     project(position);
@@ -80,7 +80,11 @@ void MotionSpan::touch(int coordinate) {
     return;
   touched_[c] = 1;
   support_.push_back(coordinate);
-  pending_.push_back(positionOf_[c]);
+  const int position = positionOf_[c];
+  if (position <= current_ || queued_[static_cast<size_t>(position)])
+    return;
+  queued_[static_cast<size_t>(position)] = 1;
+  pending_.push_back(position);
   std::push_heap(pending_.begin(), pending_.end(), std::greater<int>());
 }
 
@@ -119,6 +123,9 @@ void MotionSpan::keep() {
 
 void MotionSpan::clearWork() {
   heldPosition_ = -1;
+  current_ = -1;
+  for (int c : support_)
+    queued_[static_cast<size_t>(positionOf_[static_cast<size_t>(c)])] = 0;
   for (int c : support_) {
     work_[static_cast<size_t>(c)] = 0.0;
     touched_[static_cast<size_t>(c)] = 0;

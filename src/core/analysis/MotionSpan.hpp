@@ -69,12 +69,14 @@ class MotionSpan {
   std::vector<size_t> rowStart_{0};
   std::vector<std::vector<int>> leadingAt_;
   // The vector being reduced: dense values over every coordinate, the coordinates it touches, and the
-  // positions still to reduce (ascending).
+  // positions still to reduce (a heap, each position once).
   std::vector<double> work_;
   std::vector<char> touched_;
   std::vector<int> support_;
   std::vector<int> pending_;
-  int heldPosition_ = -1;  // where the held independent motion leads (-1: none held)
+  std::vector<char> queued_;  // per position, whether it is in pending_
+  int current_ = -1;          // the position being reduced
+  int heldPosition_ = -1;     // where the held independent motion leads (-1: none held)
 };
 
 }  // namespace core_detail

@@ -685,6 +685,8 @@ class GroupSearch {
   // Work space of one group, reused (a chain of 10^5 links has 3 10^5 groups: no allocation per group).
   std::vector<int> group_, outside_, elements_, columns_, rows_;
   std::vector<TwistRow> twistRows_;  // the rows of T (lambda entries, zero beyond)
+  Motion motion_;                    // a null twist's motion (T xi, scaled)
+  Eigen::VectorXd local_;
   Eigen::Vector3d about_ = Eigen::Vector3d::Zero();  // the point the group's twists are about
 };
 
@@ -835,7 +837,7 @@ void GroupSearch::searchNullTwists(const Eigen::MatrixXd& T, const Eigen::Matrix
   for (int k = 0; k < context_.lambda; ++k) {
     if (k < sigma.size() && sigma(k) > kTwistNullity * std::max(largest, 1.0))
       continue;
-    Eigen::VectorXd xi = svd.matrixV().col(k);
+    const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> xi = svd.matrixV().col(k);
     Eigen::Vector3d omega, v;
     if (context_.planar) {
       omega = Eigen::Vector3d(0.0, 0.0, xi(0));
@@ -846,12 +848,12 @@ void GroupSearch::searchNullTwists(const Eigen::MatrixXd& T, const Eigen::Matrix
     }
     // A motion in the span of those kept adds nothing whether or not it is finite: that is decided first,
     // the finite step (the costlier check) only for a motion that would add a dimension.
-    Motion motion;
-    const Eigen::VectorXd local = T * xi;
+    local_.noalias() = T * xi;
+    motion_.clear();
     for (size_t c = 0; c < columns_.size(); ++c)
-      motion.emplace_back(columns_[c],
-                          scale_[static_cast<size_t>(columns_[c])] * local(static_cast<Eigen::Index>(c)));
-    if (!span_.isIndependent(motion) || !movesFinitely(omega, v))
+      motion_.emplace_back(columns_[c],
+                           scale_[static_cast<size_t>(columns_[c])] * local_(static_cast<Eigen::Index>(c)));
+    if (!span_.isIndependent(motion_) || !movesFinitely(omega, v))
       continue;
     span_.keep();
     result.motions.push_back(describe(omega, v));
