@@ -44,13 +44,6 @@ class MotionSpan {
   bool isIndependent(const SparseMotion& motion);
   /// Adds the motion the last isIndependent found independent.
   void keep();
-  /// Adds @p motion when it is independent of the rows kept; @return whether it was.
-  bool addIfIndependent(const SparseMotion& motion) {
-    if (!isIndependent(motion))
-      return false;
-    keep();
-    return true;
-  }
 
   int dimension() const { return static_cast<int>(rowStart_.size()) - 1; }
 
