@@ -124,9 +124,8 @@ void MotionSpan::keep() {
 void MotionSpan::clearWork() {
   heldPosition_ = -1;
   current_ = -1;
-  for (int c : support_)
-    queued_[static_cast<size_t>(positionOf_[static_cast<size_t>(c)])] = 0;
   for (int c : support_) {
+    queued_[static_cast<size_t>(positionOf_[static_cast<size_t>(c)])] = 0;
     work_[static_cast<size_t>(c)] = 0.0;
     touched_[static_cast<size_t>(c)] = 0;
   }

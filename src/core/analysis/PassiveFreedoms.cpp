@@ -740,7 +740,7 @@ bool GroupSearch::hasTwoEndsToTwoLinks() {
   int ends = 0;
   for (int l : group_) {
     for (int j : context_.connectionsAt(l))
-      ends += inGroup_[mechanism.joints[j].link1] && inGroup_[mechanism.joints[j].link2] ? 0 : 1;
+      ends += isEnd(j) ? 1 : 0;
   }
   return outside_.size() >= 2 && ends == 2;
 }
@@ -972,9 +972,9 @@ std::string GroupSearch::endsPhrase() const {
   std::set<std::string> types;
   for (int l : group_) {
     for (int j : context_.connectionsAt(l)) {
-      const Joint& joint = mechanism.joints[j];
-      if (inGroup_[joint.link1] && inGroup_[joint.link2])
+      if (!isEnd(j))
         continue;
+      const Joint& joint = mechanism.joints[j];
       ends.push_back(j);
       types.insert(joint.kind == ConnectionKind::DistanceConstraint ? "distance" : toString(joint.type));
     }
